@@ -1,0 +1,103 @@
+"""DownpourClient: a thin wrapper over the generated Downpour stub."""
+
+import time
+
+import grpc
+from downpour.v1 import downpour_pb2 as pb
+from downpour.v1 import downpour_pb2_grpc
+from grpc_health.v1 import health_pb2, health_pb2_grpc
+
+from .messages import mode_value, to_view_spec, view_value
+
+# Four views at the largest size can exceed gRPC's default limit of 4 MiB per message.
+_MAX_MESSAGE_BYTES = 64 * 1024 * 1024
+
+
+class DownpourClient:
+    """One channel to one server. Use as a context manager to close the channel."""
+
+    def __init__(self, target="127.0.0.1:50051", timeout_s=30.0):
+        self.target = target
+        self.timeout_s = timeout_s  # deadline of each unary call
+        self._channel = grpc.insecure_channel(target, options=[
+            ("grpc.max_receive_message_length", _MAX_MESSAGE_BYTES),
+            ("grpc.max_send_message_length", _MAX_MESSAGE_BYTES),
+            # Reconnect within a second of a server (re)start instead of backing off for minutes.
+            ("grpc.initial_reconnect_backoff_ms", 100),
+            ("grpc.max_reconnect_backoff_ms", 1000),
+        ])
+        self.stub = downpour_pb2_grpc.DownpourStub(self._channel)
+        self._health = health_pb2_grpc.HealthStub(self._channel)
+
+    def close(self):
+        self._channel.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc_info):
+        self.close()
+
+    def create_session(self, views, mode="LOCKSTEP", fps=0.0, seed=0, initial=None):
+        """Views as ViewSpecs, (view, width, height[, quality]) tuples or dicts -> SessionInfo."""
+        request = pb.CreateSessionRequest(
+            views=[to_view_spec(v) for v in views], mode=mode_value(mode), fps=fps, seed=seed)
+        if initial is not None:
+            request.initial.CopyFrom(initial)
+        return self.create_session_from(request)
+
+    def create_session_from(self, request):
+        return self.stub.CreateSession(request, timeout=self.timeout_s)
+
+    def close_session(self, session_id):
+        self.stub.CloseSession(pb.CloseSessionRequest(session_id=session_id),
+                               timeout=self.timeout_s)
+
+    def list_sessions(self):
+        return list(self.stub.ListSessions(pb.ListSessionsRequest(),
+                                           timeout=self.timeout_s).sessions)
+
+    def update(self, session_id, update):
+        """Applies a partial Update; returns the session's sim time when it was accepted."""
+        response = self.stub.Update(pb.UpdateRequest(session_id=session_id, update=update),
+                                    timeout=self.timeout_s)
+        return response.sim_time_s
+
+    def step(self, session_id, dt_s, update=None):
+        """Lockstep: applies the update, advances dt_s, returns the frames (one per view)."""
+        request = pb.StepRequest(session_id=session_id, dt_s=dt_s)
+        if update is not None:
+            request.update.CopyFrom(update)
+        return list(self.stub.Step(request, timeout=self.timeout_s).frames)
+
+    def drive(self, requests, timeout_s=None):
+        """Streams DriveRequests; returns the call: iterate for DriveResponses, cancel() to end."""
+        return self.stub.Drive(iter(requests), timeout=timeout_s)
+
+    def watch_frames(self, session_id, views=(), max_fps=0.0, timeout_s=None):
+        """Returns the call, an iterator of Frames (cancel() ends it); no views = every view."""
+        request = pb.WatchFramesRequest(
+            session_id=session_id, views=[view_value(v) for v in views], max_fps=max_fps)
+        return self.stub.WatchFrames(request, timeout=timeout_s)
+
+    def get_stats(self):
+        return self.stub.GetStats(pb.GetStatsRequest(), timeout=self.timeout_s)
+
+    def wait_until_serving(self, timeout_s=30.0, service=""):
+        """Polls grpc.health.v1 Check until SERVING; raises TimeoutError after timeout_s."""
+        deadline = time.monotonic() + timeout_s
+        last = "no answer"
+        while True:
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                raise TimeoutError(
+                    f"{self.target} not SERVING after {timeout_s:g} s (last: {last})")
+            try:
+                response = self._health.Check(
+                    health_pb2.HealthCheckRequest(service=service), timeout=min(remaining, 2.0))
+                if response.status == health_pb2.HealthCheckResponse.SERVING:
+                    return
+                last = health_pb2.HealthCheckResponse.ServingStatus.Name(response.status)
+            except grpc.RpcError as error:
+                last = f"{error.code().name}: {error.details()}"
+            time.sleep(min(0.1, max(0.0, deadline - time.monotonic())))

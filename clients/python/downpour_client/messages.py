@@ -1,0 +1,77 @@
+"""Small helpers that build downpour.v1 messages from plain Python values."""
+
+from downpour.v1 import downpour_pb2 as pb
+
+_PREFIXES = {"View": "VIEW_", "Mode": "MODE_", "WiperMode": "WIPER_"}
+
+
+def _enum_value(enum_type, value, field):
+    """An enum number from a short name ("COCKPIT"), a full name ("VIEW_COCKPIT") or an int.
+
+    Ints pass through unchecked so that callers can send raw values on purpose.
+    """
+    if isinstance(value, int) and not isinstance(value, bool):
+        return value
+    if isinstance(value, str):
+        prefix = _PREFIXES[enum_type.DESCRIPTOR.name]
+        name = value.strip().upper()
+        if not name.startswith(prefix):
+            name = prefix + name
+        number = enum_type.DESCRIPTOR.values_by_name.get(name)
+        if number is not None and number.number != 0:
+            return number.number
+    allowed = ", ".join(enum_name(enum_type, v.number)
+                        for v in enum_type.DESCRIPTOR.values if v.number != 0)
+    raise ValueError(f"{field}: unknown value {value!r}, expected one of {allowed}")
+
+
+def enum_name(enum_type, value):
+    """The short name of an enum number ("COCKPIT"), or the number as text when unknown."""
+    descriptor = enum_type.DESCRIPTOR.values_by_number.get(value)
+    if descriptor is None:
+        return str(value)
+    return descriptor.name.removeprefix(_PREFIXES[enum_type.DESCRIPTOR.name])
+
+
+def view_value(value, field="view"):
+    return _enum_value(pb.View, value, field)
+
+
+def mode_value(value, field="mode"):
+    return _enum_value(pb.Mode, value, field)
+
+
+def wiper_mode_value(value, field="mode"):
+    return _enum_value(pb.WiperMode, value, field)
+
+
+def vec3(xyz):
+    x, y, z = xyz
+    return pb.Vec3(x=x, y=y, z=z)
+
+
+def rotation(yaw_pitch_roll):
+    yaw, pitch, roll = yaw_pitch_roll
+    return pb.Rotation(yaw_deg=yaw, pitch_deg=pitch, roll_deg=roll)
+
+
+def view_spec(view, width, height, quality=0, fov_deg=0.0, camera_position_m=None,
+              camera_rotation_deg=None):
+    """A ViewSpec; camera pose (VIEW_ROAD only) as (x, y, z) and (yaw, pitch, roll)."""
+    spec = pb.ViewSpec(view=view_value(view), width=width, height=height,
+                       jpeg_quality=quality, fov_deg=fov_deg)
+    if camera_position_m is not None:
+        spec.camera_position_m.CopyFrom(vec3(camera_position_m))
+    if camera_rotation_deg is not None:
+        spec.camera_rotation.CopyFrom(rotation(camera_rotation_deg))
+    return spec
+
+
+def to_view_spec(value):
+    """A ViewSpec from a ViewSpec, a tuple (view, width, height[, quality]) or a scenario dict."""
+    if isinstance(value, pb.ViewSpec):
+        return value
+    if isinstance(value, dict):
+        return view_spec(value["view"], value["width"], value["height"],
+                         value.get("jpeg_quality", 0), value.get("fov_deg", 0.0))
+    return view_spec(*value)

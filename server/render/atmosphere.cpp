@@ -1,0 +1,51 @@
+#include "server/render/atmosphere.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/common.hpp>
+#include <glm/exponential.hpp>
+#include <glm/trigonometric.hpp>
+
+namespace downpour::render {
+
+Atmosphere atmosphere_from(const sim::Weather& w) {
+  Atmosphere a;
+  const float alt = glm::radians(static_cast<float>(w.sun_altitude_deg));
+  const float az = glm::radians(static_cast<float>(w.sun_azimuth_deg));
+  a.sun_direction = glm::vec3(std::cos(alt) * std::cos(az), std::cos(alt) * std::sin(az), std::sin(alt));
+
+  const float rain = static_cast<float>(w.rain_rate_mm_h);
+  // Rain needs cloud: even light rain greys the sky; heavy rain darkens it further.
+  const float rain_cloud = 1.0f - std::exp(-rain / 3.0f);
+  a.overcast = std::clamp(std::max(static_cast<float>(w.cloudiness), rain_cloud), 0.0f, 1.0f);
+  const float rain_darkening = 1.0f - 0.55f * (1.0f - std::exp(-rain / 20.0f));
+  // Daylight fades through civil twilight (sun 6 degrees below the horizon).
+  const float day = glm::smoothstep(-6.0f, 12.0f, static_cast<float>(w.sun_altitude_deg));
+  const float night = 0.02f;
+  const float level = (night + (1.0f - night) * day) * (1.0f - 0.35f * a.overcast) * rain_darkening;
+
+  const glm::vec3 clear_zenith(0.20f, 0.42f, 0.85f);
+  const glm::vec3 clear_horizon(0.68f, 0.80f, 0.95f);
+  const glm::vec3 grey_zenith(0.52f, 0.55f, 0.58f);
+  const glm::vec3 grey_horizon(0.66f, 0.68f, 0.70f);
+  // A low sun warms the horizon.
+  const float low_sun = glm::smoothstep(25.0f, 0.0f, static_cast<float>(w.sun_altitude_deg)) * day;
+  const glm::vec3 warm(1.0f, 0.72f, 0.5f);
+  a.sky_zenith = glm::mix(clear_zenith, grey_zenith, a.overcast) * level;
+  a.sky_horizon = glm::mix(glm::mix(clear_horizon, clear_horizon * warm, low_sun), grey_horizon, a.overcast) * level;
+
+  const float sun_up = std::max(std::sin(alt), 0.0f);
+  const float direct = day * (1.0f - 0.9f * a.overcast) * rain_darkening;
+  a.sun_radiance = glm::mix(glm::vec3(1.0f, 0.95f, 0.88f), warm, low_sun) * 1.4f * direct *
+                   glm::smoothstep(0.0f, 0.1f, sun_up);
+  a.ambient = glm::mix(a.sky_zenith, a.sky_horizon, 0.5f) * 0.9f;
+
+  // Extinction: clear air sees kilometres; rain and fog bring the horizon in.
+  a.fog_density = 0.00012f + static_cast<float>(w.fog_density) * 0.012f + rain * 0.00004f;
+  a.fog_colour = a.sky_horizon;
+  a.wetness = std::clamp(rain / 5.0f, 0.0f, 1.0f);
+  return a;
+}
+
+}  // namespace downpour::render

@@ -1,0 +1,46 @@
+#include "server/render/camera.hpp"
+
+#include <cmath>
+
+#include <glm/trigonometric.hpp>
+
+#include "server/render/vehicle_geometry.hpp"
+#include "server/sim/pose.hpp"
+
+namespace downpour::render {
+
+sim::CameraPose default_camera_pose(sim::View view) {
+  switch (view) {
+    case sim::View::kRoad: return {{-6.5, 0.0, 2.6}, {0.0, 11.0, 0.0}};
+    default: return {kDriverEye, {0.0, 2.0, 0.0}};
+  }
+}
+
+double default_fov_deg(sim::View view) { return view == sim::View::kRoad ? 55.0 : 60.0; }
+
+Camera make_camera(const sim::ViewSpec& spec, const sim::VehicleState& vehicle) {
+  const sim::CameraPose pose = spec.camera ? *spec.camera : default_camera_pose(spec.view);
+  // Camera frame in the vehicle frame, then GL's camera axes (x right, y up, looking down -z).
+  glm::dmat4 cam_in_vehicle(sim::rotation_matrix(pose.rotation));
+  cam_in_vehicle[3] = glm::dvec4(pose.position_m, 1.0);
+  const glm::dmat4 gl_axes(glm::dvec4(0, -1, 0, 0), glm::dvec4(0, 0, 1, 0), glm::dvec4(-1, 0, 0, 0),
+                           glm::dvec4(0, 0, 0, 1));
+  const glm::dmat4 cam_to_world = sim::vehicle_to_world(vehicle) * cam_in_vehicle * gl_axes;
+
+  Camera c;
+  c.fov_y_deg = static_cast<float>(spec.fov_deg > 0.0 ? spec.fov_deg : default_fov_deg(spec.view));
+  c.position = glm::vec3(cam_to_world[3]);
+  c.view = glm::mat4(glm::inverse(cam_to_world));
+  // Reversed-Z with an infinite far plane (clip control zero-to-one, depth test GREATER, clear 0):
+  // float depth keeps its precision from the dashboard at 0.3 m to hills kilometres away.
+  const float f = 1.0f / std::tan(glm::radians(c.fov_y_deg) * 0.5f);
+  const float aspect = static_cast<float>(spec.width) / static_cast<float>(spec.height);
+  c.projection = glm::mat4(0.0f);
+  c.projection[0][0] = f / aspect;
+  c.projection[1][1] = f;
+  c.projection[2][3] = -1.0f;
+  c.projection[3][2] = c.near_m;
+  return c;
+}
+
+}  // namespace downpour::render

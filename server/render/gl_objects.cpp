@@ -1,0 +1,141 @@
+#include "server/render/gl_objects.hpp"
+
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <string_view>
+
+#include <glm/gtc/type_ptr.hpp>
+
+namespace downpour::render {
+
+const std::map<std::string, std::string_view>& embedded_shaders();  // generated at build time
+
+namespace {
+
+std::string shader_source(const std::string& file, int depth = 0) {
+  const auto& shaders = embedded_shaders();
+  const auto it = shaders.find(file);
+  if (it == shaders.end()) throw std::runtime_error("no embedded shader named " + file);
+  if (depth > 4) throw std::runtime_error("shader includes nest too deep at " + file);
+  std::istringstream in{std::string(it->second)};
+  std::ostringstream out;
+  std::string line;
+  while (std::getline(in, line)) {
+    const std::string directive = "#include \"";
+    if (line.rfind(directive, 0) == 0) {
+      const auto end = line.find('"', directive.size());
+      out << shader_source(line.substr(directive.size(), end - directive.size()), depth + 1) << "\n";
+    } else {
+      out << line << "\n";
+    }
+  }
+  return out.str();
+}
+
+GLuint compile(GLenum stage, const std::string& file) {
+  const std::string source = shader_source(file);
+  const GLuint shader = glCreateShader(stage);
+  const char* text = source.c_str();
+  glShaderSource(shader, 1, &text, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
+    glDeleteShader(shader);
+    throw std::runtime_error("compiling " + file + ": " + log);
+  }
+  return shader;
+}
+
+}  // namespace
+
+Texture make_texture_2d(GLenum internal_format, int width, int height, int levels) {
+  GLuint id = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &id);
+  glTextureStorage2D(id, levels, internal_format, width, height);
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, levels > 1 ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR);
+  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  return Texture(id);
+}
+
+ShaderProgram::ShaderProgram(const std::string& vertex_file, const std::string& fragment_file) {
+  const GLuint vs = compile(GL_VERTEX_SHADER, vertex_file);
+  GLuint fs = 0;
+  try {
+    fs = compile(GL_FRAGMENT_SHADER, fragment_file);
+  } catch (...) {
+    glDeleteShader(vs);
+    throw;
+  }
+  const GLuint program = glCreateProgram();
+  glAttachShader(program, vs);
+  glAttachShader(program, fs);
+  glLinkProgram(program);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  program_ = GlName<gl_delete::program>(program);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetProgramInfoLog(program, sizeof(log), nullptr, log);
+    throw std::runtime_error("linking " + vertex_file + " + " + fragment_file + ": " + log);
+  }
+}
+
+GLint ShaderProgram::location(const char* name) {
+  const auto it = locations_.find(name);
+  if (it != locations_.end()) return it->second;
+  const GLint loc = glGetUniformLocation(program_.id(), name);
+  locations_.emplace(name, loc);
+  return loc;
+}
+
+void ShaderProgram::set(const char* name, const glm::mat4& m) {
+  glProgramUniformMatrix4fv(program_.id(), location(name), 1, GL_FALSE, glm::value_ptr(m));
+}
+
+Mesh::Mesh(const MeshData& data)
+    : bounds_min(data.bounds_min), bounds_max(data.bounds_max), index_count_(static_cast<GLsizei>(data.indices.size())) {
+  const auto& vertices = data.vertices;
+  const auto& indices = data.indices;
+  GLuint ids[2];
+  glCreateBuffers(2, ids);
+  vbo_ = Buffer(ids[0]);
+  ibo_ = Buffer(ids[1]);
+  glNamedBufferStorage(vbo_.id(), vertices.size() * sizeof(MeshVertex), vertices.data(), 0);
+  glNamedBufferStorage(ibo_.id(), indices.size() * sizeof(std::uint32_t), indices.data(), 0);
+  GLuint vao = 0;
+  glCreateVertexArrays(1, &vao);
+  vao_ = VertexArray(vao);
+  glVertexArrayVertexBuffer(vao, 0, vbo_.id(), 0, sizeof(MeshVertex));
+  glVertexArrayElementBuffer(vao, ibo_.id());
+  const GLuint offsets[] = {offsetof(MeshVertex, position), offsetof(MeshVertex, normal), offsetof(MeshVertex, uv)};
+  const GLint sizes[] = {3, 3, 2};
+  for (GLuint a = 0; a < 3; ++a) {
+    glEnableVertexArrayAttrib(vao, a);
+    glVertexArrayAttribFormat(vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
+    glVertexArrayAttribBinding(vao, a, 0);
+  }
+}
+
+void Mesh::draw() const {
+  glBindVertexArray(vao_.id());
+  glDrawElements(GL_TRIANGLES, index_count_, GL_UNSIGNED_INT, nullptr);
+}
+
+FullscreenTriangle::FullscreenTriangle() {
+  GLuint vao = 0;
+  glCreateVertexArrays(1, &vao);
+  vao_ = VertexArray(vao);
+}
+
+void FullscreenTriangle::draw() const {
+  glBindVertexArray(vao_.id());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+}  // namespace downpour::render

@@ -1,0 +1,105 @@
+// Small owning wrappers for GL objects, and shader programs built from the embedded sources.
+// Render thread only.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "server/render/gl.hpp"
+#include "server/render/mesh_data.hpp"
+
+namespace downpour::render {
+
+// A GL name with a deleter; move-only.
+template <void (*Delete)(GLuint)>
+class GlName {
+ public:
+  GlName() = default;
+  explicit GlName(GLuint id) : id_(id) {}
+  ~GlName() { if (id_) Delete(id_); }
+  GlName(GlName&& o) noexcept : id_(o.id_) { o.id_ = 0; }
+  GlName& operator=(GlName&& o) noexcept {
+    if (this != &o) {
+      if (id_) Delete(id_);
+      id_ = o.id_;
+      o.id_ = 0;
+    }
+    return *this;
+  }
+  GLuint id() const { return id_; }
+
+ private:
+  GLuint id_ = 0;
+};
+
+namespace gl_delete {
+inline void texture(GLuint id) { glDeleteTextures(1, &id); }
+inline void buffer(GLuint id) { glDeleteBuffers(1, &id); }
+inline void framebuffer(GLuint id) { glDeleteFramebuffers(1, &id); }
+inline void vertex_array(GLuint id) { glDeleteVertexArrays(1, &id); }
+inline void program(GLuint id) { glDeleteProgram(id); }
+}  // namespace gl_delete
+
+using Texture = GlName<gl_delete::texture>;
+using Buffer = GlName<gl_delete::buffer>;
+using Framebuffer = GlName<gl_delete::framebuffer>;
+using VertexArray = GlName<gl_delete::vertex_array>;
+
+Texture make_texture_2d(GLenum internal_format, int width, int height, int levels = 1);
+
+// A linked program from embedded shader files (by file name, e.g. "sky.frag"). Files may start
+// with `#include "common.glsl"` lines, resolved from the embedded set. Throws with the GL log.
+class ShaderProgram {
+ public:
+  ShaderProgram(const std::string& vertex_file, const std::string& fragment_file);
+  void use() const { glUseProgram(program_.id()); }
+  GLint location(const char* name);
+
+  void set(const char* name, float v) { glProgramUniform1f(program_.id(), location(name), v); }
+  void set(const char* name, int v) { glProgramUniform1i(program_.id(), location(name), v); }
+  void set(const char* name, glm::vec2 v) { glProgramUniform2f(program_.id(), location(name), v.x, v.y); }
+  void set(const char* name, glm::vec3 v) { glProgramUniform3f(program_.id(), location(name), v.x, v.y, v.z); }
+  void set(const char* name, glm::vec4 v) { glProgramUniform4f(program_.id(), location(name), v.x, v.y, v.z, v.w); }
+  void set(const char* name, const glm::mat4& m);
+
+ private:
+  GlName<gl_delete::program> program_;
+  std::unordered_map<std::string, GLint> locations_;
+};
+
+// A static indexed triangle mesh, uploaded from MeshData (attributes 0 position, 1 normal, 2 uv),
+// with its bounds for culling.
+class Mesh {
+ public:
+  Mesh() = default;
+  explicit Mesh(const MeshData& data);
+  void draw() const;
+  bool empty() const { return index_count_ == 0; }
+  glm::vec3 bounds_min{0.0f};
+  glm::vec3 bounds_max{0.0f};
+
+ private:
+  VertexArray vao_;
+  Buffer vbo_;
+  Buffer ibo_;
+  GLsizei index_count_ = 0;
+};
+
+// Draws one triangle that covers the viewport; the vertex shader makes it from gl_VertexID.
+class FullscreenTriangle {
+ public:
+  FullscreenTriangle();
+  void draw() const;
+
+ private:
+  VertexArray vao_;
+};
+
+}  // namespace downpour::render

@@ -1,0 +1,37 @@
+#include "server/render/passes/vehicle_pass.hpp"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "server/render/vehicle_geometry.hpp"
+#include "server/sim/pose.hpp"
+
+namespace downpour::render {
+
+VehiclePass::VehiclePass(SharedResources&)
+    : program_("mesh.vert", "vehicle.frag"), hull_(build_car_hull()), upper_(build_car_upper()) {}
+
+void VehiclePass::draw_car(const glm::mat4& model, const glm::vec3& colour, bool hull_only) {
+  program_.set("u_model", model);
+  program_.set("u_body_colour", colour);
+  hull_.draw();
+  if (!hull_only) upper_.draw();
+}
+
+void VehiclePass::draw(const FrameContext& frame) {
+  program_.use();
+  const bool cockpit = frame.spec.view == sim::View::kCockpit;
+  draw_car(frame.vehicle_to_world, glm::vec3(0.42f, 0.05f, 0.04f), cockpit);
+  const glm::mat4 view_proj = frame.camera.projection * frame.camera.view;
+  static const glm::vec3 palette[] = {{0.75f, 0.75f, 0.78f}, {0.05f, 0.06f, 0.08f}, {0.1f, 0.2f, 0.45f},
+                                      {0.55f, 0.55f, 0.5f},  {0.35f, 0.02f, 0.02f}, {0.9f, 0.9f, 0.88f}};
+  for (const sim::TrafficVehicle& other : frame.scene.traffic) {
+    // The car shape is 4.6 x 1.8 x 1.47 m from the rear axle; scale it to the reported size.
+    const glm::vec3 scale(other.size_m.x / 4.6, other.size_m.y / 1.8, other.size_m.z / 1.47);
+    const glm::mat4 model = glm::scale(glm::mat4(sim::vehicle_to_world(other.state)), scale);
+    const glm::vec3 centre = glm::vec3(model * glm::vec4(1.35f, 0.0f, 0.7f, 1.0f));
+    if (!box_visible(view_proj, centre - glm::vec3(4.0f), centre + glm::vec3(4.0f))) continue;
+    draw_car(model, palette[other.id % 6], false);
+  }
+}
+
+}  // namespace downpour::render

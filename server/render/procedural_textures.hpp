@@ -1,0 +1,22 @@
+// Textures made on the CPU at start-up, deterministic, tileable. No GL.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace downpour::render {
+
+struct Image8 {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgba;  // 4 bytes a pixel, rows top-down
+};
+
+// Asphalt micro-relief (seed 003, section 3.1): an 8-bit height field of packed aggregate in a
+// darker binder, in alpha; its normals (relief scale relief_depth texels per unit height) in rgb.
+Image8 make_asphalt_relief(int size, std::uint32_t seed, float relief_depth = 3.0f);
+
+// Tileable value noise with a different frequency in each channel (4, 8, 16, 32 cells).
+Image8 make_noise(int size, std::uint32_t seed);
+
+}  // namespace downpour::render

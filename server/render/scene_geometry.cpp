@@ -1,0 +1,136 @@
+#include "server/render/scene_geometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+namespace downpour::render {
+namespace {
+
+constexpr double kVerge = 4.0;         // metres of verge beyond the paved edge
+constexpr double kVergeDrop = 0.35;    // how far the verge falls below the pavement edge
+constexpr double kTerrainCell = 20.0;  // metres
+constexpr double kTerrainMargin = 1300.0;
+constexpr int kTerrainChunks = 8;      // per axis
+
+double hills(double x, double y) {
+  return 5.0 * std::sin(x / 170.0 + 1.3) * std::cos(y / 210.0 - 0.4) + 2.5 * std::sin((x + 0.6 * y) / 85.0) +
+         1.2 * std::cos((0.7 * x - y) / 41.0);
+}
+
+}  // namespace
+
+std::vector<MeshData> build_road_chunks(const sim::Track& track, double chunk_length_m) {
+  const double half = track.paved_half_width();
+  // Lateral stations of the cross-section, left positive.
+  const std::vector<double> stations = {-half - kVerge, -half, -track.cross_section().lanes_each_way *
+                                                                   track.cross_section().lane_width_m,
+                                        0.0, track.cross_section().lanes_each_way * track.cross_section().lane_width_m,
+                                        half, half + kVerge};
+  std::vector<MeshData> chunks;
+  const double step = 2.0;
+  const int rows_total = static_cast<int>(std::ceil(track.length() / step));
+  const int rows_per_chunk = std::max(1, static_cast<int>(chunk_length_m / step));
+  for (int first = 0; first < rows_total; first += rows_per_chunk) {
+    MeshData m;
+    const int last = std::min(rows_total, first + rows_per_chunk);
+    for (int row = first; row <= last; ++row) {
+      const double s = std::min(row * step, track.length());
+      const sim::TrackFrame f = track.at(s);
+      for (double lat : stations) {
+        const double clamped = std::clamp(lat, -half, half);
+        double z = track.surface_height(s, clamped);
+        if (std::abs(lat) > half) z -= kVergeDrop * (std::abs(lat) - half) / kVerge;
+        const glm::dvec2 xy = glm::dvec2(f.position) + f.left * lat;
+        // Normal from the cross-slope and the grade.
+        const double cross = std::abs(lat) < 1e-9 ? 0.0
+                             : (std::abs(lat) <= half ? track.cross_section().crown_slope
+                                                      : kVergeDrop / kVerge) *
+                                   (lat > 0 ? -1.0 : 1.0);
+        const glm::dvec3 forward(std::cos(f.heading_rad), std::sin(f.heading_rad), f.grade);
+        const glm::dvec3 side(f.left.x, f.left.y, cross);
+        const glm::dvec3 n = glm::normalize(glm::cross(forward, side));
+        m.add_vertex(glm::vec3(xy.x, xy.y, z), glm::vec3(n), glm::vec2(lat, s));
+      }
+    }
+    const int cols = static_cast<int>(stations.size());
+    for (int r = 0; r < last - first; ++r) {
+      for (int c = 0; c + 1 < cols; ++c) {
+        const auto i = static_cast<std::uint32_t>(r * cols + c);
+        m.add_quad(i, i + 1, i + 1 + cols, i + cols);
+      }
+    }
+    chunks.push_back(std::move(m));
+  }
+  return chunks;
+}
+
+double terrain_height(const sim::Track& track, double x, double y) {
+  const sim::Track::Projection p = track.project({x, y}, 150.0);
+  const double half = track.paved_half_width();
+  const double edge = track.surface_height(p.s, std::copysign(half, p.lateral)) - kVergeDrop - 0.15;
+  const double d = std::abs(p.lateral) - half - kVerge;
+  // Far from the track the ground rises to a ring of low mountains.
+  const glm::dvec2 centre(450.0, 250.0);
+  const double r = glm::length(glm::dvec2(x, y) - centre);
+  const double far_hills = 70.0 * glm::smoothstep(1000.0, 1800.0, r) * (0.7 + 0.3 * std::sin(x / 300.0 + y / 410.0));
+  const double natural = edge + hills(x, y) + far_hills;
+  const double blend = glm::smoothstep(0.0, 60.0, d);
+  return glm::mix(std::min(edge, natural) , natural, blend);
+}
+
+std::vector<MeshData> build_terrain_chunks(const sim::Track& track) {
+  // Bounds of the track plus a margin.
+  glm::dvec2 lo(1e30), hi(-1e30);
+  for (double s = 0.0; s < track.length(); s += 20.0) {
+    const glm::dvec2 p(track.at(s).position);
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  lo -= kTerrainMargin;
+  hi += kTerrainMargin;
+  const int nx = static_cast<int>(std::ceil((hi.x - lo.x) / kTerrainCell));
+  const int ny = static_cast<int>(std::ceil((hi.y - lo.y) / kTerrainCell));
+  std::vector<float> heights(static_cast<std::size_t>((nx + 1) * (ny + 1)));
+  for (int j = 0; j <= ny; ++j) {
+    for (int i = 0; i <= nx; ++i) {
+      heights[j * (nx + 1) + i] =
+          static_cast<float>(terrain_height(track, lo.x + i * kTerrainCell, lo.y + j * kTerrainCell));
+    }
+  }
+  auto h = [&](int i, int j) {
+    i = std::clamp(i, 0, nx);
+    j = std::clamp(j, 0, ny);
+    return heights[j * (nx + 1) + i];
+  };
+  std::vector<MeshData> chunks;
+  for (int cj = 0; cj < kTerrainChunks; ++cj) {
+    for (int ci = 0; ci < kTerrainChunks; ++ci) {
+      const int i0 = nx * ci / kTerrainChunks, i1 = nx * (ci + 1) / kTerrainChunks;
+      const int j0 = ny * cj / kTerrainChunks, j1 = ny * (cj + 1) / kTerrainChunks;
+      MeshData m;
+      for (int j = j0; j <= j1; ++j) {
+        for (int i = i0; i <= i1; ++i) {
+          const float x = static_cast<float>(lo.x + i * kTerrainCell);
+          const float y = static_cast<float>(lo.y + j * kTerrainCell);
+          const glm::vec3 n = glm::normalize(glm::vec3(h(i - 1, j) - h(i + 1, j), h(i, j - 1) - h(i, j + 1),
+                                                       2.0f * static_cast<float>(kTerrainCell)));
+          m.add_vertex({x, y, h(i, j)}, n, {x, y});
+        }
+      }
+      const int cols = i1 - i0 + 1;
+      for (int j = 0; j < j1 - j0; ++j) {
+        for (int i = 0; i < i1 - i0; ++i) {
+          const auto a = static_cast<std::uint32_t>(j * cols + i);
+          m.add_quad(a, a + 1, a + 1 + cols, a + cols);
+        }
+      }
+      chunks.push_back(std::move(m));
+    }
+  }
+  return chunks;
+}
+
+}  // namespace downpour::render

@@ -1,0 +1,68 @@
+#include "server/render/vehicle_geometry.hpp"
+
+#include <glm/geometric.hpp>
+
+namespace downpour::render {
+
+MeshData build_car_hull() {
+  MeshData m;
+  // Lower body from the rear bumper (x = -0.95) to the front bumper (x = 3.65).
+  m.add_frustum({-0.95f, -0.9f, 0.28f}, {3.65f, 0.9f, 0.92f}, {-0.9f, -0.88f}, {3.6f, 0.88f}, material::kBody);
+  return m;
+}
+
+MeshData build_car_upper() {
+  MeshData m;
+  // Cabin: glass house narrowing towards the roof.
+  m.add_frustum({-0.55f, -0.82f, 0.92f}, {2.06f, 0.82f, 1.45f}, {-0.2f, -0.7f}, {1.4f, 0.7f}, material::kGlass);
+  m.add_box({-0.15f, -0.71f, 1.44f}, {1.35f, 0.71f, 1.47f}, material::kBody);  // roof panel
+  // Wheels: radius 0.33 at the axles x = 0 and x = 2.7.
+  for (float x : {0.0f, 2.7f}) {
+    for (float y : {-0.8f, 0.8f}) {
+      m.add_box({x - 0.33f, y - 0.11f, 0.0f}, {x + 0.33f, y + 0.11f, 0.66f}, material::kTyre);
+    }
+  }
+  // Tail and head lamps.
+  m.add_box({-0.97f, -0.85f, 0.72f}, {-0.93f, -0.55f, 0.85f}, material::kLamp);
+  m.add_box({-0.97f, 0.55f, 0.72f}, {-0.93f, 0.85f, 0.85f}, material::kLamp);
+  return m;
+}
+
+MeshData build_cockpit_interior(const WindshieldCorners& g) {
+  MeshData m;
+  const float dash_back = 1.45f;
+  // Dashboard top: from the glass's lower edge back towards the driver, slightly lower at the back.
+  m.add_face({dash_back, -0.85f, g.bottom_left.z - 0.03f}, {g.bottom_right.x, -0.85f, g.bottom_right.z - 0.005f},
+             {g.bottom_left.x, 0.85f, g.bottom_left.z - 0.005f}, {dash_back, 0.85f, g.bottom_left.z - 0.03f},
+             material::kTrim);
+  // Its face towards the driver.
+  m.add_face({dash_back, 0.85f, 0.55f}, {dash_back, -0.85f, 0.55f}, {dash_back, -0.85f, g.bottom_left.z - 0.03f},
+             {dash_back, 0.85f, g.bottom_left.z - 0.03f}, material::kTrim);
+  // Instrument hood in front of the driver.
+  m.add_frustum({dash_back - 0.02f, 0.17f, 0.9f}, {1.78f, 0.57f, 1.03f}, {dash_back, 0.2f}, {1.66f, 0.54f},
+                material::kTrim);
+  // A-pillars along the glass's side edges, 9 cm wide, 6 cm deep.
+  for (int side : {-1, 1}) {
+    const glm::vec3 lo = side > 0 ? g.bottom_left : g.bottom_right;
+    const glm::vec3 hi = side > 0 ? g.top_left : g.top_right;
+    const glm::vec3 out(0.0f, side * 0.09f, 0.0f);
+    const glm::vec3 in(-0.04f, 0.0f, -0.05f);
+    // Inner face, seen from the cabin, and the side face towards the glass.
+    if (side > 0) {
+      m.add_face(lo + in, hi + in, hi + out + in, lo + out + in, material::kTrim);
+      m.add_face(lo, hi, hi + in, lo + in, material::kTrim);
+    } else {
+      m.add_face(lo + in, lo + out + in, hi + out + in, hi + in, material::kTrim);
+      m.add_face(lo, lo + in, hi + in, hi, material::kTrim);
+    }
+  }
+  // Roof liner from the glass's top edge back over the driver.
+  m.add_face({g.top_right.x + 0.02f, -0.9f, g.top_right.z}, {g.top_left.x + 0.02f, 0.9f, g.top_left.z},
+             {0.2f, 0.9f, g.top_left.z + 0.06f}, {0.2f, -0.9f, g.top_right.z + 0.06f}, material::kTrim);
+  // Rear-view mirror on a short stem.
+  m.add_box({1.5f, -0.11f, 1.25f}, {1.53f, 0.11f, 1.31f}, material::kBody);
+  m.add_box({1.47f, -0.012f, 1.31f}, {1.49f, 0.012f, 1.37f}, material::kTrim);
+  return m;
+}
+
+}  // namespace downpour::render

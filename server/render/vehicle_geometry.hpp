@@ -1,0 +1,37 @@
+// The ego vehicle's shape in the vehicle frame (x forward from the rear axle, y left, z up): a
+// simple car body for outside views, and the cockpit interior that frames the driver's view.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include "server/render/mesh_data.hpp"
+
+namespace downpour::render {
+
+inline constexpr glm::dvec3 kDriverEye{1.05, 0.37, 1.22};
+
+// Windshield corners, vehicle frame: a glass raked about 60 degrees from vertical.
+struct WindshieldCorners {
+  glm::vec3 bottom_right{2.06f, -0.76f, 0.98f};
+  glm::vec3 bottom_left{2.06f, 0.76f, 0.98f};
+  glm::vec3 top_left{1.40f, 0.68f, 1.36f};
+  glm::vec3 top_right{1.40f, -0.68f, 1.36f};
+};
+
+// Material ids carried in uv.x, read by vehicle.frag and cockpit.frag.
+namespace material {
+inline constexpr float kBody = 0.0f;
+inline constexpr float kGlass = 1.0f;
+inline constexpr float kTyre = 2.0f;
+inline constexpr float kLamp = 3.0f;
+inline constexpr float kTrim = 4.0f;
+}  // namespace material
+
+// A passenger car about 4.6 x 1.8 x 1.47 m: the hull (the lower body, whose hood shows from the
+// driver's seat) and the rest (cabin, roof, wheels, lamps).
+MeshData build_car_hull();
+MeshData build_car_upper();
+// Dashboard, A-pillars, roof edge and mirror as seen from the driver's seat.
+MeshData build_cockpit_interior(const WindshieldCorners& glass);
+
+}  // namespace downpour::render

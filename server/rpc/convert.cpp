@@ -1,0 +1,61 @@
+#include "server/rpc/convert.hpp"
+
+namespace downpour::rpc {
+
+v1::View to_proto(sim::View view) {
+  switch (view) {
+    case sim::View::kCockpit: return v1::VIEW_COCKPIT;
+    case sim::View::kRoad: return v1::VIEW_ROAD;
+    case sim::View::kWindshield: return v1::VIEW_WINDSHIELD;
+    case sim::View::kRain: return v1::VIEW_RAIN;
+  }
+  return v1::VIEW_UNSPECIFIED;
+}
+
+void fill_frame(const session::EncodedFrame& f, std::uint64_t reader_drops, v1::Frame* out) {
+  out->set_session_id(f.session_id);
+  out->set_frame_number(f.frame_number);
+  out->set_sim_time_s(f.sim_time_s);
+  out->set_client_time_s(f.client_time_s);
+  out->set_view(to_proto(f.view));
+  out->set_width(static_cast<std::uint32_t>(f.width));
+  out->set_height(static_cast<std::uint32_t>(f.height));
+  out->set_jpeg(f.jpeg);
+  v1::FrameStats* s = out->mutable_stats();
+  s->set_render_ms(f.stats.render_ms);
+  s->set_readback_ms(f.stats.readback_ms);
+  s->set_encode_ms(f.stats.encode_ms);
+  s->set_latency_ms(f.stats.latency_ms);
+  s->set_drops_on_glass(f.stats.drops_on_glass);
+  s->set_glass_wet_fraction(f.stats.glass_wet_fraction);
+  s->set_view_wet_fraction(f.stats.view_wet_fraction);
+  s->set_frames_dropped(reader_drops);
+}
+
+void fill_session_info(const session::Session& session, v1::SessionInfo* out) {
+  const session::SessionConfig& c = session.config();
+  out->set_session_id(session.id());
+  out->set_mode(c.mode == sim::Mode::kLockstep ? v1::MODE_LOCKSTEP : v1::MODE_REALTIME);
+  out->set_fps(c.fps);
+  out->set_seed(c.seed);
+  for (const sim::ViewSpec& v : c.views) {
+    v1::ViewSpec* spec = out->add_views();
+    spec->set_view(to_proto(v.view));
+    spec->set_width(static_cast<std::uint32_t>(v.width));
+    spec->set_height(static_cast<std::uint32_t>(v.height));
+    spec->set_jpeg_quality(static_cast<std::uint32_t>(v.jpeg_quality));
+    spec->set_fov_deg(v.fov_deg);
+    if (v.camera) {
+      spec->mutable_camera_position_m()->set_x(v.camera->position_m.x);
+      spec->mutable_camera_position_m()->set_y(v.camera->position_m.y);
+      spec->mutable_camera_position_m()->set_z(v.camera->position_m.z);
+      spec->mutable_camera_rotation()->set_yaw_deg(v.camera->rotation.yaw_deg);
+      spec->mutable_camera_rotation()->set_pitch_deg(v.camera->rotation.pitch_deg);
+      spec->mutable_camera_rotation()->set_roll_deg(v.camera->rotation.roll_deg);
+    }
+  }
+  out->set_frames_rendered(session.frames_rendered());
+  out->set_sim_time_s(session.sim_time_s());
+}
+
+}  // namespace downpour::rpc

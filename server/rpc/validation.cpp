@@ -1,0 +1,215 @@
+#include "server/rpc/validation.hpp"
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+namespace downpour::rpc {
+namespace {
+
+std::string number_text(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+grpc::Status invalid(const std::string& field, const std::string& what) {
+  return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, field + ": " + what);
+}
+
+grpc::Status in_range(double v, double lo, double hi, const std::string& field) {
+  if (!std::isfinite(v)) return invalid(field, "must be a finite number, got " + number_text(v));
+  if (v < lo || v > hi) {
+    return invalid(field, "must be in [" + number_text(lo) + ", " + number_text(hi) + "], got " + number_text(v));
+  }
+  return grpc::Status::OK;
+}
+
+#define DP_RETURN_IF_ERROR(expr)          \
+  do {                                    \
+    const grpc::Status status_ = (expr);  \
+    if (!status_.ok()) return status_;    \
+  } while (0)
+
+grpc::Status to_vec3(const v1::Vec3& in, double limit, const std::string& field, glm::dvec3* out) {
+  DP_RETURN_IF_ERROR(in_range(in.x(), -limit, limit, field + ".x"));
+  DP_RETURN_IF_ERROR(in_range(in.y(), -limit, limit, field + ".y"));
+  DP_RETURN_IF_ERROR(in_range(in.z(), -limit, limit, field + ".z"));
+  *out = glm::dvec3(in.x(), in.y(), in.z());
+  return grpc::Status::OK;
+}
+
+grpc::Status to_rotation(const v1::Rotation& in, const std::string& field, sim::Rotation* out) {
+  DP_RETURN_IF_ERROR(in_range(in.yaw_deg(), -3600.0, 3600.0, field + ".yaw_deg"));
+  DP_RETURN_IF_ERROR(in_range(in.pitch_deg(), -90.0, 90.0, field + ".pitch_deg"));
+  DP_RETURN_IF_ERROR(in_range(in.roll_deg(), -180.0, 180.0, field + ".roll_deg"));
+  *out = {in.yaw_deg(), in.pitch_deg(), in.roll_deg()};
+  return grpc::Status::OK;
+}
+
+grpc::Status to_vehicle(const v1::VehicleState& in, const std::string& field, sim::VehicleState* out) {
+  DP_RETURN_IF_ERROR(to_vec3(in.position_m(), 1e6, field + ".position_m", &out->position_m));
+  DP_RETURN_IF_ERROR(to_rotation(in.rotation(), field + ".rotation", &out->rotation));
+  DP_RETURN_IF_ERROR(to_vec3(in.velocity_mps(), 150.0, field + ".velocity_mps", &out->velocity_mps));
+  return grpc::Status::OK;
+}
+
+grpc::Status to_wipers(const v1::WiperState& in, const std::string& field, sim::WiperState* out) {
+  switch (in.mode()) {
+    case v1::WIPER_OFF: out->mode = sim::WiperMode::kOff; break;
+    case v1::WIPER_INTERMITTENT: out->mode = sim::WiperMode::kIntermittent; break;
+    case v1::WIPER_LOW: out->mode = sim::WiperMode::kLow; break;
+    case v1::WIPER_HIGH: out->mode = sim::WiperMode::kHigh; break;
+    case v1::WIPER_SINGLE: out->mode = sim::WiperMode::kSingle; break;
+    case v1::WIPER_MANUAL: out->mode = sim::WiperMode::kManual; break;
+    default:
+      return invalid(field + ".mode", "must be one of WIPER_OFF, WIPER_INTERMITTENT, WIPER_LOW, WIPER_HIGH, "
+                                      "WIPER_SINGLE, WIPER_MANUAL, got " + std::to_string(in.mode()));
+  }
+  if (in.interval_s() != 0.0 || !std::isfinite(in.interval_s())) {
+    DP_RETURN_IF_ERROR(in_range(in.interval_s(), 0.5, 60.0, field + ".interval_s"));
+  }
+  out->interval_s = in.interval_s() > 0.0 ? in.interval_s() : 4.0;
+  if (in.blade_angle_deg_size() > 2) {
+    return invalid(field + ".blade_angle_deg", "at most 2 blades, got " + std::to_string(in.blade_angle_deg_size()));
+  }
+  if (out->mode == sim::WiperMode::kManual && in.blade_angle_deg_size() == 0) {
+    return invalid(field + ".blade_angle_deg", "WIPER_MANUAL needs at least one blade angle");
+  }
+  out->blade_angle_deg.clear();
+  for (int i = 0; i < in.blade_angle_deg_size(); ++i) {
+    DP_RETURN_IF_ERROR(in_range(in.blade_angle_deg(i), 0.0, 180.0, field + ".blade_angle_deg[" + std::to_string(i) + "]"));
+    out->blade_angle_deg.push_back(in.blade_angle_deg(i));
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status to_weather(const v1::Weather& in, const std::string& f, sim::Weather* out) {
+  DP_RETURN_IF_ERROR(in_range(in.rain_rate_mm_h(), 0.0, 500.0, f + ".rain_rate_mm_h"));
+  DP_RETURN_IF_ERROR(in_range(in.wind_speed_mps(), 0.0, 100.0, f + ".wind_speed_mps"));
+  DP_RETURN_IF_ERROR(in_range(in.wind_direction_deg(), -360.0, 360.0, f + ".wind_direction_deg"));
+  DP_RETURN_IF_ERROR(in_range(in.fog_density(), 0.0, 1.0, f + ".fog_density"));
+  DP_RETURN_IF_ERROR(in_range(in.cloudiness(), 0.0, 1.0, f + ".cloudiness"));
+  DP_RETURN_IF_ERROR(in_range(in.sun_altitude_deg(), -90.0, 90.0, f + ".sun_altitude_deg"));
+  DP_RETURN_IF_ERROR(in_range(in.sun_azimuth_deg(), -360.0, 360.0, f + ".sun_azimuth_deg"));
+  DP_RETURN_IF_ERROR(in_range(in.rain_streak_count(), 0.0, 80000.0, f + ".rain_streak_count"));
+  DP_RETURN_IF_ERROR(in_range(in.rain_angle_deg(), -70.0, 70.0, f + ".rain_angle_deg"));
+  *out = {in.rain_rate_mm_h(), in.wind_speed_mps(), in.wind_direction_deg(), in.fog_density(), in.cloudiness(),
+          in.sun_altitude_deg(), in.sun_azimuth_deg(), in.rain_streak_count(), in.rain_angle_deg()};
+  return grpc::Status::OK;
+}
+
+}  // namespace
+
+grpc::Status to_update(const v1::Update& in, const std::string& field, const Limits& limits, sim::Update* out) {
+  DP_RETURN_IF_ERROR(in_range(in.sim_time_s(), -1e9, 1e9, field + ".sim_time_s"));
+  sim::Update u;
+  u.client_time_s = in.sim_time_s();
+  if (in.has_vehicle()) {
+    u.vehicle.emplace();
+    DP_RETURN_IF_ERROR(to_vehicle(in.vehicle(), field + ".vehicle", &*u.vehicle));
+  }
+  if (in.has_wipers()) {
+    u.wipers.emplace();
+    DP_RETURN_IF_ERROR(to_wipers(in.wipers(), field + ".wipers", &*u.wipers));
+  }
+  if (in.has_weather()) {
+    u.weather.emplace();
+    DP_RETURN_IF_ERROR(to_weather(in.weather(), field + ".weather", &*u.weather));
+  }
+  if (in.traffic_size() > limits.max_traffic) {
+    return invalid(field + ".traffic", "at most " + std::to_string(limits.max_traffic) + " vehicles, got " +
+                                           std::to_string(in.traffic_size()));
+  }
+  if (in.replace_traffic() || in.traffic_size() > 0) {
+    u.traffic.emplace();
+    for (int i = 0; i < in.traffic_size(); ++i) {
+      const std::string tf = field + ".traffic[" + std::to_string(i) + "]";
+      const v1::TrafficVehicle& t = in.traffic(i);
+      sim::TrafficVehicle v;
+      v.id = t.id();
+      DP_RETURN_IF_ERROR(to_vehicle(t.state(), tf + ".state", &v.state));
+      if (t.has_size_m()) {
+        glm::dvec3 size;
+        DP_RETURN_IF_ERROR(to_vec3(t.size_m(), 30.0, tf + ".size_m", &size));
+        if (size.x > 0.0 && size.y > 0.0 && size.z > 0.0) v.size_m = size;
+      }
+      u.traffic->push_back(v);
+    }
+  }
+  *out = std::move(u);
+  return grpc::Status::OK;
+}
+
+grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, const Limits& limits, sim::ViewSpec* out) {
+  switch (in.view()) {
+    case v1::VIEW_COCKPIT: out->view = sim::View::kCockpit; break;
+    case v1::VIEW_ROAD: out->view = sim::View::kRoad; break;
+    case v1::VIEW_WINDSHIELD: out->view = sim::View::kWindshield; break;
+    case v1::VIEW_RAIN: out->view = sim::View::kRain; break;
+    default:
+      return invalid(field + ".view", "must be one of VIEW_COCKPIT, VIEW_ROAD, VIEW_WINDSHIELD, VIEW_RAIN, got " +
+                                          std::to_string(in.view()));
+  }
+  DP_RETURN_IF_ERROR(in_range(in.width(), 16, limits.max_width, field + ".width"));
+  DP_RETURN_IF_ERROR(in_range(in.height(), 16, limits.max_height, field + ".height"));
+  out->width = static_cast<int>(in.width());
+  out->height = static_cast<int>(in.height());
+  if (in.jpeg_quality() != 0) DP_RETURN_IF_ERROR(in_range(in.jpeg_quality(), 1, 100, field + ".jpeg_quality"));
+  out->jpeg_quality = in.jpeg_quality() == 0 ? 85 : static_cast<int>(in.jpeg_quality());
+  if (in.fov_deg() != 0.0 || !std::isfinite(in.fov_deg())) {
+    DP_RETURN_IF_ERROR(in_range(in.fov_deg(), 1.0, 170.0, field + ".fov_deg"));
+  }
+  out->fov_deg = in.fov_deg();
+  if (in.has_camera_position_m() || in.has_camera_rotation()) {
+    if (out->view != sim::View::kRoad) return invalid(field + ".camera_position_m", "a camera pose is for VIEW_ROAD only");
+    sim::CameraPose pose;
+    DP_RETURN_IF_ERROR(to_vec3(in.camera_position_m(), 100.0, field + ".camera_position_m", &pose.position_m));
+    DP_RETURN_IF_ERROR(to_rotation(in.camera_rotation(), field + ".camera_rotation", &pose.rotation));
+    out->camera = pose;
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status to_session_config(const v1::CreateSessionRequest& in, const Limits& limits,
+                               session::SessionConfig* config, sim::Update* initial) {
+  if (in.views_size() == 0) return invalid("views", "at least one view is needed");
+  if (in.views_size() > limits.max_views) {
+    return invalid("views", "at most " + std::to_string(limits.max_views) + " views, got " + std::to_string(in.views_size()));
+  }
+  session::SessionConfig c;
+  std::set<sim::View> seen;
+  for (int i = 0; i < in.views_size(); ++i) {
+    const std::string field = "views[" + std::to_string(i) + "]";
+    sim::ViewSpec spec;
+    DP_RETURN_IF_ERROR(to_view_spec(in.views(i), field, limits, &spec));
+    if (!seen.insert(spec.view).second) return invalid(field + ".view", "each view at most once per session");
+    c.views.push_back(spec);
+  }
+  switch (in.mode()) {
+    case v1::MODE_UNSPECIFIED:
+    case v1::MODE_REALTIME: c.mode = sim::Mode::kRealtime; break;
+    case v1::MODE_LOCKSTEP: c.mode = sim::Mode::kLockstep; break;
+    default: return invalid("mode", "must be MODE_REALTIME or MODE_LOCKSTEP, got " + std::to_string(in.mode()));
+  }
+  if (in.fps() != 0.0 || !std::isfinite(in.fps())) DP_RETURN_IF_ERROR(in_range(in.fps(), 0.1, limits.max_fps, "fps"));
+  c.fps = in.fps() > 0.0 ? in.fps() : 30.0;
+  c.seed = in.seed();
+  DP_RETURN_IF_ERROR(to_update(in.initial(), "initial", limits, initial));
+  *config = std::move(c);
+  return grpc::Status::OK;
+}
+
+grpc::Status check_dt(double dt_s, const std::string& field, bool allow_zero, const Limits& limits) {
+  DP_RETURN_IF_ERROR(in_range(dt_s, 0.0, limits.max_dt_s, field));
+  if (!allow_zero && dt_s == 0.0) return invalid(field, "must be in (0, " + number_text(limits.max_dt_s) + "], got 0");
+  return grpc::Status::OK;
+}
+
+grpc::Status check_session_id(const std::string& id, const std::string& field) {
+  if (id.empty()) return invalid(field, "is required");
+  if (id.size() > 64) return invalid(field, "is longer than 64 characters");
+  return grpc::Status::OK;
+}
+
+}  // namespace downpour::rpc

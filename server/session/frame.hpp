@@ -1,0 +1,45 @@
+// An encoded frame as it leaves the pipeline, shared (read-only) by every reader that gets it.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "server/sim/types.hpp"
+
+namespace downpour::session {
+
+struct FrameStats {
+  double render_ms = 0.0;
+  double readback_ms = 0.0;
+  double encode_ms = 0.0;
+  double latency_ms = 0.0;  // from the arrival of the inputs the tick consumed to the encoded frame
+  std::uint32_t drops_on_glass = 0;
+  double glass_wet_fraction = 0.0;
+  double view_wet_fraction = 0.0;
+};
+
+struct EncodedFrame {
+  std::string session_id;
+  std::uint64_t frame_number = 0;
+  double sim_time_s = 0.0;
+  double client_time_s = 0.0;
+  sim::View view = sim::View::kCockpit;
+  int width = 0;
+  int height = 0;
+  std::string jpeg;
+  FrameStats stats;
+};
+
+using FramePtr = std::shared_ptr<const EncodedFrame>;
+
+// Something that receives a session's frames as they are encoded: a WatchFrames reader, a
+// realtime Drive stream. Called on encoder threads; must not block.
+class FrameSink {
+ public:
+  virtual ~FrameSink() = default;
+  virtual void on_frame(const FramePtr& frame) = 0;
+  virtual void on_session_closed() = 0;
+};
+
+}  // namespace downpour::session

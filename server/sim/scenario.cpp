@@ -1,0 +1,331 @@
+#include "server/sim/scenario.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "server/sim/track.hpp"
+
+namespace downpour::sim {
+namespace {
+
+using nlohmann::json;
+
+double lerp(double a, double b, double u) { return a + (b - a) * u; }
+
+double lerp_angle_deg(double a, double b, double u) {
+  const double d = std::remainder(b - a, 360.0);  // in [-180, 180]
+  return a + d * u;
+}
+
+VehicleState mix(const VehicleState& a, const VehicleState& b, double u) {
+  VehicleState v;
+  v.position_m = a.position_m + (b.position_m - a.position_m) * u;
+  v.velocity_mps = a.velocity_mps + (b.velocity_mps - a.velocity_mps) * u;
+  v.rotation.yaw_deg = lerp_angle_deg(a.rotation.yaw_deg, b.rotation.yaw_deg, u);
+  v.rotation.pitch_deg = lerp_angle_deg(a.rotation.pitch_deg, b.rotation.pitch_deg, u);
+  v.rotation.roll_deg = lerp_angle_deg(a.rotation.roll_deg, b.rotation.roll_deg, u);
+  return v;
+}
+
+Weather mix(const Weather& a, const Weather& b, double u) {
+  Weather w;
+  w.rain_rate_mm_h = lerp(a.rain_rate_mm_h, b.rain_rate_mm_h, u);
+  w.wind_speed_mps = lerp(a.wind_speed_mps, b.wind_speed_mps, u);
+  w.wind_direction_deg = lerp_angle_deg(a.wind_direction_deg, b.wind_direction_deg, u);
+  w.fog_density = lerp(a.fog_density, b.fog_density, u);
+  w.cloudiness = lerp(a.cloudiness, b.cloudiness, u);
+  w.sun_altitude_deg = lerp(a.sun_altitude_deg, b.sun_altitude_deg, u);
+  w.sun_azimuth_deg = lerp_angle_deg(a.sun_azimuth_deg, b.sun_azimuth_deg, u);
+  w.rain_streak_count = static_cast<std::uint32_t>(
+      std::lround(lerp(a.rain_streak_count, b.rain_streak_count, u)));
+  w.rain_angle_deg = lerp(a.rain_angle_deg, b.rain_angle_deg, u);
+  return w;
+}
+
+// Interpolates one channel (a member of Keyframe) at t.
+template <typename T, typename Mix>
+std::optional<T> sample(const std::vector<Keyframe>& keys, std::optional<T> Keyframe::*channel,
+                        double t, Mix mix_fn) {
+  const Keyframe* before = nullptr;
+  const Keyframe* after = nullptr;
+  for (const Keyframe& k : keys) {
+    if (!(k.*channel)) continue;
+    if (k.t <= t) {
+      before = &k;
+    } else {
+      after = &k;
+      break;
+    }
+  }
+  if (!before && !after) return std::nullopt;
+  if (!before) return *(after->*channel);
+  if (!after || after->t <= before->t) return *(before->*channel);
+  const double u = (t - before->t) / (after->t - before->t);
+  return mix_fn(*(before->*channel), *(after->*channel), u);
+}
+
+const char* wiper_mode_name(WiperMode m) {
+  switch (m) {
+    case WiperMode::kOff: return "OFF";
+    case WiperMode::kIntermittent: return "INTERMITTENT";
+    case WiperMode::kLow: return "LOW";
+    case WiperMode::kHigh: return "HIGH";
+    case WiperMode::kSingle: return "SINGLE";
+    case WiperMode::kManual: return "MANUAL";
+  }
+  return "OFF";
+}
+
+[[noreturn]] void fail(const std::string& field, const std::string& what) {
+  throw std::runtime_error("scenario " + field + ": " + what);
+}
+
+double number(const json& j, const char* key, const std::string& where, double fallback) {
+  if (!j.contains(key)) return fallback;
+  const json& v = j.at(key);
+  if (!v.is_number()) fail(where + "." + key, "must be a number");
+  const double d = v.get<double>();
+  if (!std::isfinite(d)) fail(where + "." + key, "must be finite");
+  return d;
+}
+
+glm::dvec3 vec3(const json& j, const char* key, const std::string& where) {
+  if (!j.contains(key)) return glm::dvec3(0.0);
+  const json& v = j.at(key);
+  if (!v.is_array() || v.size() != 3) fail(where + "." + key, "must be an array of 3 numbers");
+  glm::dvec3 out;
+  for (int i = 0; i < 3; ++i) {
+    if (!v[i].is_number()) fail(where + "." + key, "must be an array of 3 numbers");
+    out[i] = v[i].get<double>();
+  }
+  return out;
+}
+
+View parse_view(const std::string& name, const std::string& where) {
+  for (int i = 0; i < kViewCount; ++i) {
+    if (view_name(static_cast<View>(i)) == name) return static_cast<View>(i);
+  }
+  fail(where, "unknown view '" + name + "'");
+}
+
+WiperMode parse_wiper_mode(const std::string& name, const std::string& where) {
+  for (WiperMode m : {WiperMode::kOff, WiperMode::kIntermittent, WiperMode::kLow, WiperMode::kHigh,
+                      WiperMode::kSingle, WiperMode::kManual}) {
+    if (name == wiper_mode_name(m)) return m;
+  }
+  fail(where, "unknown wiper mode '" + name + "'");
+}
+
+}  // namespace
+
+Update Scenario::at(double t_in) const {
+  double t = t_in;
+  if (loop && duration_s > 0.0) {
+    t = std::fmod(t, duration_s);
+    if (t < 0.0) t += duration_s;
+  }
+  Update u;
+  u.client_time_s = t_in;
+  u.vehicle = sample(keyframes, &Keyframe::vehicle, t,
+                     [](const VehicleState& a, const VehicleState& b, double w) { return mix(a, b, w); });
+  u.weather = sample(keyframes, &Keyframe::weather, t,
+                     [](const Weather& a, const Weather& b, double w) { return mix(a, b, w); });
+  u.wipers = sample(keyframes, &Keyframe::wipers, t,
+                    [](const WiperState& a, const WiperState&, double) { return a; });
+  return u;
+}
+
+Scenario Scenario::from_json(const std::string& text) {
+  json root;
+  try {
+    root = json::parse(text);
+  } catch (const json::parse_error& e) {
+    fail("file", std::string("is not valid JSON: ") + e.what());
+  }
+  if (!root.is_object()) fail("file", "must be a JSON object");
+  Scenario s;
+  s.name = root.value("name", "");
+  s.description = root.value("description", "");
+  s.duration_s = number(root, "duration_s", "", 0.0);
+  s.loop = root.value("loop", false);
+  s.seed = root.value("seed", std::uint64_t{0});
+  s.fps = number(root, "fps", "", 30.0);
+  if (s.fps <= 0.0) fail("fps", "must be positive");
+  for (std::size_t i = 0; i < root.value("views", json::array()).size(); ++i) {
+    const json& jv = root["views"][i];
+    const std::string where = "views[" + std::to_string(i) + "]";
+    ViewSpec v;
+    v.view = parse_view(jv.value("view", ""), where + ".view");
+    v.width = static_cast<int>(number(jv, "width", where, 640));
+    v.height = static_cast<int>(number(jv, "height", where, 360));
+    v.jpeg_quality = static_cast<int>(number(jv, "jpeg_quality", where, 85));
+    v.fov_deg = number(jv, "fov_deg", where, 0.0);
+    s.views.push_back(v);
+  }
+  const json keys = root.value("keyframes", json::array());
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const json& jk = keys[i];
+    const std::string where = "keyframes[" + std::to_string(i) + "]";
+    Keyframe k;
+    k.t = number(jk, "t", where, 0.0);
+    if (!s.keyframes.empty() && k.t < s.keyframes.back().t) fail(where + ".t", "keyframes must be sorted by t");
+    if (jk.contains("vehicle")) {
+      const json& jv = jk["vehicle"];
+      VehicleState v;
+      v.position_m = vec3(jv, "position_m", where + ".vehicle");
+      const glm::dvec3 r = vec3(jv, "rotation_deg", where + ".vehicle");
+      v.rotation = {r.x, r.y, r.z};
+      v.velocity_mps = vec3(jv, "velocity_mps", where + ".vehicle");
+      k.vehicle = v;
+    }
+    if (jk.contains("wipers")) {
+      const json& jw = jk["wipers"];
+      WiperState w;
+      w.mode = parse_wiper_mode(jw.value("mode", "OFF"), where + ".wipers.mode");
+      w.interval_s = number(jw, "interval_s", where + ".wipers", 4.0);
+      w.blade_angle_deg = jw.value("blade_angle_deg", std::vector<double>{});
+      k.wipers = w;
+    }
+    if (jk.contains("weather")) {
+      const json& jw = jk["weather"];
+      const std::string ww = where + ".weather";
+      Weather w;
+      w.rain_rate_mm_h = number(jw, "rain_rate_mm_h", ww, w.rain_rate_mm_h);
+      w.wind_speed_mps = number(jw, "wind_speed_mps", ww, w.wind_speed_mps);
+      w.wind_direction_deg = number(jw, "wind_direction_deg", ww, w.wind_direction_deg);
+      w.fog_density = number(jw, "fog_density", ww, w.fog_density);
+      w.cloudiness = number(jw, "cloudiness", ww, w.cloudiness);
+      w.sun_altitude_deg = number(jw, "sun_altitude_deg", ww, w.sun_altitude_deg);
+      w.sun_azimuth_deg = number(jw, "sun_azimuth_deg", ww, w.sun_azimuth_deg);
+      w.rain_streak_count = static_cast<std::uint32_t>(number(jw, "rain_streak_count", ww, 0));
+      w.rain_angle_deg = number(jw, "rain_angle_deg", ww, w.rain_angle_deg);
+      k.weather = w;
+    }
+    s.keyframes.push_back(std::move(k));
+  }
+  return s;
+}
+
+std::string Scenario::to_json() const {
+  json root;
+  root["name"] = name;
+  root["description"] = description;
+  root["duration_s"] = duration_s;
+  root["loop"] = loop;
+  root["seed"] = seed;
+  root["fps"] = fps;
+  root["views"] = json::array();
+  for (const ViewSpec& v : views) {
+    root["views"].push_back({{"view", view_name(v.view)}, {"width", v.width}, {"height", v.height},
+                             {"jpeg_quality", v.jpeg_quality}, {"fov_deg", v.fov_deg}});
+  }
+  root["keyframes"] = json::array();
+  auto round_to = [](double x, double unit) { return std::round(x / unit) * unit; };
+  for (const Keyframe& k : keyframes) {
+    json jk;
+    jk["t"] = round_to(k.t, 1e-6);
+    if (k.vehicle) {
+      const VehicleState& v = *k.vehicle;
+      auto arr = [&](glm::dvec3 x, double unit) {
+        return json::array({round_to(x.x, unit), round_to(x.y, unit), round_to(x.z, unit)});
+      };
+      jk["vehicle"] = {{"position_m", arr(v.position_m, 1e-4)},
+                       {"rotation_deg", arr({v.rotation.yaw_deg, v.rotation.pitch_deg, v.rotation.roll_deg}, 1e-4)},
+                       {"velocity_mps", arr(v.velocity_mps, 1e-4)}};
+    }
+    if (k.wipers) {
+      jk["wipers"] = {{"mode", wiper_mode_name(k.wipers->mode)},
+                      {"interval_s", k.wipers->interval_s},
+                      {"blade_angle_deg", k.wipers->blade_angle_deg}};
+    }
+    if (k.weather) {
+      const Weather& w = *k.weather;
+      jk["weather"] = {{"rain_rate_mm_h", w.rain_rate_mm_h},   {"wind_speed_mps", w.wind_speed_mps},
+                       {"wind_direction_deg", w.wind_direction_deg}, {"fog_density", w.fog_density},
+                       {"cloudiness", w.cloudiness},           {"sun_altitude_deg", w.sun_altitude_deg},
+                       {"sun_azimuth_deg", w.sun_azimuth_deg}, {"rain_streak_count", w.rain_streak_count},
+                       {"rain_angle_deg", w.rain_angle_deg}};
+    }
+    root["keyframes"].push_back(jk);
+  }
+  return root.dump(1) + "\n";
+}
+
+namespace {
+
+// Keyframes that drive the test track's lane at a constant speed, one lap, every step_s seconds.
+std::vector<Keyframe> drive_lap(const Track& track, int lane, double speed_mps, double step_s) {
+  std::vector<Keyframe> keys;
+  const double lap_s = track.length() / speed_mps;
+  const double lateral = track.lane_centre(lane);
+  // Whole steps of about step_s, so that the last keyframe closes the loop onto the first.
+  const int steps = static_cast<int>(std::ceil(lap_s / step_s));
+  for (int i = 0; i <= steps; ++i) {
+    const double t = lap_s * i / steps;
+    const double s = speed_mps * t;
+    const TrackFrame f = track.at(s);
+    VehicleState v;
+    v.position_m = f.position + glm::dvec3(f.left * lateral, 0.0);
+    v.position_m.z = track.surface_height(s, lateral);
+    v.rotation.yaw_deg = std::remainder(f.heading_rad * 180.0 / M_PI, 360.0);
+    v.rotation.pitch_deg = -std::atan(f.grade) * 180.0 / M_PI;
+    const glm::dvec2 dir(std::cos(f.heading_rad), std::sin(f.heading_rad));
+    v.velocity_mps = glm::dvec3(dir * speed_mps, f.grade * speed_mps);
+    keys.push_back({t, v, std::nullopt, std::nullopt});
+  }
+  return keys;
+}
+
+}  // namespace
+
+Scenario highway_heavy_rain() {
+  const Track track = Track::test_track();
+  Scenario s;
+  s.name = "highway_heavy_rain";
+  s.description = "The test track's outer lane at 25 m/s in 25 mm/h rain, wipers on high, overcast.";
+  s.loop = true;
+  s.seed = 7;
+  s.fps = 30.0;
+  s.views = {{View::kCockpit, 640, 360, 85, 0.0, std::nullopt}, {View::kRoad, 640, 360, 85, 0.0, std::nullopt}};
+  s.keyframes = drive_lap(track, 1, 25.0, 0.5);
+  s.duration_s = s.keyframes.back().t;
+  Weather w;
+  w.rain_rate_mm_h = 25.0;
+  w.wind_speed_mps = 4.0;
+  w.wind_direction_deg = 60.0;
+  w.fog_density = 0.15;
+  w.cloudiness = 0.95;
+  w.sun_altitude_deg = 30.0;
+  w.sun_azimuth_deg = 200.0;
+  s.keyframes.front().weather = w;
+  s.keyframes.front().wipers = WiperState{WiperMode::kHigh, 0.0, {}};
+  return s;
+}
+
+Scenario city_drizzle() {
+  const Track track = Track::test_track();
+  Scenario s;
+  s.name = "city_drizzle";
+  s.description = "The test track's inner lane at 8 m/s in 2 mm/h drizzle, intermittent wipers.";
+  s.loop = true;
+  s.seed = 11;
+  s.fps = 30.0;
+  s.views = {{View::kCockpit, 640, 360, 85, 0.0, std::nullopt}, {View::kRoad, 640, 360, 85, 0.0, std::nullopt}};
+  s.keyframes = drive_lap(track, 0, 8.0, 1.0);
+  s.duration_s = s.keyframes.back().t;
+  Weather w;
+  w.rain_rate_mm_h = 2.0;
+  w.wind_speed_mps = 1.5;
+  w.fog_density = 0.05;
+  w.cloudiness = 0.7;
+  w.sun_altitude_deg = 50.0;
+  w.sun_azimuth_deg = 150.0;
+  s.keyframes.front().weather = w;
+  s.keyframes.front().wipers = WiperState{WiperMode::kIntermittent, 6.0, {}};
+  return s;
+}
+
+}  // namespace downpour::sim

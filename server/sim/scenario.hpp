@@ -1,0 +1,42 @@
+// Scenario files: a timeline of vehicle pose, wipers and weather keyframes, interpolated. The same
+// JSON format is read by the Python client (clients/python/downpour_client/scenario.py).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "server/sim/types.hpp"
+
+namespace downpour::sim {
+
+struct Keyframe {
+  double t = 0.0;
+  std::optional<VehicleState> vehicle;
+  std::optional<WiperState> wipers;
+  std::optional<Weather> weather;
+};
+
+struct Scenario {
+  std::string name;
+  std::string description;
+  double duration_s = 0.0;
+  bool loop = false;
+  std::uint64_t seed = 0;
+  double fps = 30.0;
+  std::vector<ViewSpec> views;
+  std::vector<Keyframe> keyframes;  // sorted by t
+
+  // Per channel: linear between the neighbouring keyframes that carry it (rotation along the
+  // shortest arc), wipers held from the last keyframe at or before t; held outside the range.
+  Update at(double t) const;
+
+  static Scenario from_json(const std::string& text);  // throws std::runtime_error naming the field
+  std::string to_json() const;
+};
+
+// The standard scenes, defined once here and used by the benchmarks and the clients.
+Scenario highway_heavy_rain();
+Scenario city_drizzle();
+
+}  // namespace downpour::sim

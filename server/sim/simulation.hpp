@@ -1,0 +1,46 @@
+// One session's deterministic world: the simulator's inputs and the clock, advanced in fixed
+// sub-steps. Later issues add the windshield water, rain and road water here.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "server/sim/types.hpp"
+
+namespace downpour::sim {
+
+struct SimulationConfig {
+  double sub_step_s = 1.0 / 240.0;  // fixed, so that lockstep runs reproduce
+};
+
+// What the renderer reads: a copy, taken on the render thread after a step.
+struct SceneState {
+  double sim_time_s = 0.0;
+  double client_time_s = 0.0;
+  std::uint64_t sub_steps = 0;
+  VehicleState vehicle;
+  WiperState wipers;
+  Weather weather;
+  std::vector<TrafficVehicle> traffic;
+};
+
+class Simulation {
+ public:
+  Simulation(std::uint64_t seed, const Update& initial, SimulationConfig config = {});
+
+  void apply(const Update& update);
+  // Advances by dt in whole sub-steps; the remainder carries into the next call.
+  void advance(double dt_s);
+
+  const SceneState& state() const { return state_; }
+
+ private:
+  void sub_step();
+
+  SimulationConfig config_;
+  SceneState state_;
+  std::uint64_t seed_;  // seeds the random streams of the effects that later issues add
+  double carry_s_ = 0.0;
+};
+
+}  // namespace downpour::sim

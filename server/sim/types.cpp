@@ -1,0 +1,23 @@
+#include "server/sim/types.hpp"
+
+namespace downpour::sim {
+
+void Update::merge_from(const Update& later) {
+  client_time_s = later.client_time_s;
+  if (later.vehicle) vehicle = later.vehicle;
+  if (later.wipers) wipers = later.wipers;
+  if (later.weather) weather = later.weather;
+  if (later.traffic) traffic = later.traffic;
+}
+
+std::string_view view_name(View view) {
+  switch (view) {
+    case View::kCockpit: return "COCKPIT";
+    case View::kRoad: return "ROAD";
+    case View::kWindshield: return "WINDSHIELD";
+    case View::kRain: return "RAIN";
+  }
+  return "UNKNOWN";
+}
+
+}  // namespace downpour::sim

@@ -1,0 +1,87 @@
+// Domain types shared by every layer: what a simulator tells a session, and what it asks to see.
+// Plain data, no GL and no gRPC; rpc/ converts to and from the wire types.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace downpour::sim {
+
+// Yaw / pitch / roll in degrees: yaw about world z (counter-clockwise from +x), then pitch about
+// the vehicle's y (nose down positive, as ISO 8855), then roll about its x.
+struct Rotation {
+  double yaw_deg = 0.0;
+  double pitch_deg = 0.0;
+  double roll_deg = 0.0;
+};
+
+struct VehicleState {
+  glm::dvec3 position_m{0.0};  // world frame, ground point under the rear axle centre
+  Rotation rotation;
+  glm::dvec3 velocity_mps{0.0};  // world frame
+};
+
+enum class WiperMode { kOff, kIntermittent, kLow, kHigh, kSingle, kManual };
+
+struct WiperState {
+  WiperMode mode = WiperMode::kOff;
+  double interval_s = 4.0;
+  std::vector<double> blade_angle_deg;  // kManual: one per blade, from park
+};
+
+struct Weather {
+  double rain_rate_mm_h = 0.0;
+  double wind_speed_mps = 0.0;
+  double wind_direction_deg = 0.0;
+  double fog_density = 0.0;
+  double cloudiness = 0.2;
+  double sun_altitude_deg = 40.0;
+  double sun_azimuth_deg = 135.0;
+  std::uint32_t rain_streak_count = 0;
+  double rain_angle_deg = 0.0;
+};
+
+struct TrafficVehicle {
+  std::uint32_t id = 0;
+  VehicleState state;
+  glm::dvec3 size_m{4.5, 1.8, 1.5};
+};
+
+// A partial update: what is present is applied, what is absent keeps its value.
+struct Update {
+  double client_time_s = 0.0;
+  std::optional<VehicleState> vehicle;
+  std::optional<WiperState> wipers;
+  std::optional<Weather> weather;
+  std::optional<std::vector<TrafficVehicle>> traffic;  // present = replaces the list
+
+  // Later fields win; used to fold several realtime updates into one before a tick.
+  void merge_from(const Update& later);
+};
+
+enum class View { kCockpit = 0, kRoad = 1, kWindshield = 2, kRain = 3 };
+inline constexpr int kViewCount = 4;
+std::string_view view_name(View view);
+
+struct CameraPose {
+  glm::dvec3 position_m{0.0};  // vehicle frame
+  Rotation rotation;           // relative to the vehicle frame
+};
+
+struct ViewSpec {
+  View view = View::kCockpit;
+  int width = 640;
+  int height = 360;
+  int jpeg_quality = 85;
+  double fov_deg = 0.0;               // 0 = the view's default
+  std::optional<CameraPose> camera;  // kRoad only; absent = chase camera
+};
+
+enum class Mode { kRealtime, kLockstep };
+
+}  // namespace downpour::sim

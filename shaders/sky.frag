@@ -1,0 +1,20 @@
+#version 450
+#include "common.glsl"
+in vec2 v_uv;
+out vec4 out_colour;
+void main() {
+  vec4 far_point = frame.inv_view_proj * vec4(v_uv * 2.0 - 1.0, 1e-6, 1.0);
+  vec3 dir = normalize(far_point.xyz / far_point.w - frame.camera_pos.xyz);
+  vec3 sky = sky_gradient(dir);
+  // A cloud deck at about 1.5 km, drifting with the wind; it thickens and greys with overcast.
+  if (dir.z > 0.0) {
+    vec2 p = frame.camera_pos.xy + dir.xy * (1500.0 / (dir.z + 0.08)) + frame.wind.xy * frame.params.x * 3.0;
+    float n = texture(noise_tex, p / 9000.0).r * 0.6 + texture(noise_tex, p / 2300.0).g * 0.4;
+    float overcast = frame.params.y;
+    float cover = smoothstep(0.75 - overcast * 0.8, 1.05 - overcast * 0.6, n);
+    vec3 cloud_lit = mix(frame.sky_horizon.rgb * 1.15, frame.sky_horizon.rgb * 0.7, overcast * n);
+    cloud_lit += frame.sun_radiance.rgb * 0.12;
+    sky = mix(sky, cloud_lit, cover * smoothstep(0.0, 0.15, dir.z));
+  }
+  out_colour = vec4(to_display(sky), 1.0);
+}

@@ -1,0 +1,13 @@
+# Regenerates the standard scenes and fails if the committed JSON files differ.
+file(MAKE_DIRECTORY ${WORK})
+execute_process(COMMAND ${SCENES} ${WORK} RESULT_VARIABLE rc OUTPUT_QUIET)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "downpour-scenes failed")
+endif()
+foreach(name highway_heavy_rain city_drizzle)
+  file(READ ${WORK}/${name}.json generated)
+  file(READ ${SOURCE}/${name}.json committed)
+  if(NOT generated STREQUAL committed)
+    message(FATAL_ERROR "clients/scenarios/${name}.json is stale: run build/downpour-scenes clients/scenarios")
+  endif()
+endforeach()

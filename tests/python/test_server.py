@@ -1,0 +1,288 @@
+"""Integration: the real server binary (env DOWNPOUR_SERVER) driven by the Python client."""
+
+import hashlib
+import io
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import unittest
+
+import grpc
+from PIL import Image
+
+from downpour_client import DownpourClient, view_spec
+from downpour.v1 import downpour_pb2 as pb
+
+SERVER = os.environ.get("DOWNPOUR_SERVER")
+
+REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+START_TIMEOUT_S = 60.0
+DT = 0.05
+VIEWS = [view_spec("COCKPIT", 160, 90), view_spec("ROAD", 128, 72)]
+SIZES = {pb.VIEW_COCKPIT: (160, 90), pb.VIEW_ROAD: (128, 72)}
+
+
+def setUpModule():
+    if not SERVER:
+        raise unittest.SkipTest("DOWNPOUR_SERVER is not set")
+
+
+def inputs(step):
+    """The update of lockstep step `step`: the car drives on, rain grows, the wipers start."""
+    update = pb.Update(sim_time_s=step * DT)
+    update.vehicle.position_m.x = 20.0 * step * DT
+    update.vehicle.velocity_mps.x = 20.0
+    update.weather.rain_rate_mm_h = 20.0 + step
+    update.weather.cloudiness = 0.8
+    update.weather.sun_altitude_deg = 30.0
+    update.wipers.mode = pb.WIPER_HIGH if step >= 2 else pb.WIPER_OFF
+    return update
+
+
+def image_size(jpeg):
+    with Image.open(io.BytesIO(jpeg)) as image:
+        image.load()
+        return image.format, image.size
+
+
+class ServerTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.folder = tempfile.TemporaryDirectory()
+        port_file = os.path.join(cls.folder.name, "port")
+        cls.log = open(os.path.join(cls.folder.name, "server.log"), "w+b")
+        env = dict(os.environ, EGL_PLATFORM="surfaceless", LP_NUM_THREADS="2")
+        cls.process = subprocess.Popen(
+            [SERVER, "--listen", "127.0.0.1:0", "--port-file", port_file, "--log-level", "warn"],
+            env=env, stdout=cls.log, stderr=subprocess.STDOUT)
+        cls.client = None
+        try:
+            deadline = time.monotonic() + START_TIMEOUT_S
+            cls.port = cls._read_port(port_file, deadline)
+            cls.target = f"127.0.0.1:{cls.port}"
+            cls.client = DownpourClient(cls.target)
+            cls.client.wait_until_serving(max(1.0, deadline - time.monotonic()))
+        except BaseException:
+            cls._stop_server()
+            raise
+
+    @classmethod
+    def _read_port(cls, port_file, deadline):
+        while time.monotonic() < deadline:
+            if cls.process.poll() is not None:
+                raise RuntimeError(f"server exited with {cls.process.returncode}:\n{cls._log()}")
+            try:
+                with open(port_file) as file:
+                    return int(file.read().strip())
+            except (OSError, ValueError):
+                time.sleep(0.05)
+        raise RuntimeError(f"no port file after {START_TIMEOUT_S:g} s:\n{cls._log()}")
+
+    @classmethod
+    def _log(cls):
+        cls.log.flush()
+        cls.log.seek(0)
+        return cls.log.read().decode(errors="replace")[-4000:]
+
+    @classmethod
+    def _stop_server(cls):
+        if cls.client is not None:
+            cls.client.close()
+        cls.process.send_signal(signal.SIGTERM)
+        try:
+            code = cls.process.wait(timeout=15)
+        except subprocess.TimeoutExpired:
+            cls.process.kill()
+            code = cls.process.wait()
+        log = cls._log()
+        cls.log.close()
+        cls.folder.cleanup()
+        return code, log
+
+    @classmethod
+    def tearDownClass(cls):
+        code, log = cls._stop_server()
+        if code != 0:
+            raise AssertionError(f"server exited with {code} after SIGTERM:\n{log}")
+
+    def open_session(self, views=VIEWS, mode=pb.MODE_LOCKSTEP, seed=7, fps=0.0):
+        info = self.client.create_session(views, mode=mode, seed=seed, fps=fps,
+                                          initial=inputs(0))
+        self.addCleanup(self._close_quietly, info.session_id)
+        return info.session_id
+
+    def _close_quietly(self, session_id):
+        try:
+            self.client.close_session(session_id)
+        except grpc.RpcError:
+            pass
+
+    def check_frames(self, frames, session_id, frame_number):
+        """One frame per view, all of tick frame_number, each a JPEG of the requested size."""
+        self.assertEqual(sorted(f.view for f in frames), sorted(SIZES))
+        for frame in frames:
+            self.assertEqual(frame.session_id, session_id)
+            self.assertEqual(frame.frame_number, frame_number)
+            self.assertEqual((frame.width, frame.height), SIZES[frame.view])
+            self.assertEqual(image_size(frame.jpeg), ("JPEG", SIZES[frame.view]))
+
+    def test_step_renders_every_view(self):
+        session_id = self.open_session()
+        numbers, sim_times = [], []
+        for step in range(1, 4):
+            frames = self.client.step(session_id, DT, inputs(step))
+            numbers.append(frames[0].frame_number)
+            sim_times.append(frames[0].sim_time_s)
+            self.check_frames(frames, session_id, numbers[0] + step - 1)
+            for frame in frames:
+                self.assertAlmostEqual(frame.client_time_s, step * DT)
+                self.assertEqual(frame.sim_time_s, sim_times[-1])
+        self.assertAlmostEqual(sim_times[1] - sim_times[0], DT)
+        self.assertAlmostEqual(sim_times[2] - sim_times[1], DT)
+        self.assertAlmostEqual(self.sim_time(session_id), sim_times[-1])
+
+    def sim_time(self, session_id):
+        for session in self.client.list_sessions():
+            if session.session_id == session_id:
+                return session.sim_time_s
+        self.fail(f"{session_id} is not listed")
+
+    def test_drive_lockstep_answers_each_time_step(self):
+        session_id = self.open_session()
+        steps = [DT, DT, 0.0, DT, DT, DT]  # dt 0 applies the update only: no response
+        requests = [pb.DriveRequest(session_id=session_id if i == 0 else "",
+                                    update=inputs(i + 1), dt_s=dt)
+                    for i, dt in enumerate(steps)]
+        responses = list(self.client.drive(requests, timeout_s=30))
+        self.assertEqual(len(responses), 5)
+        first = responses[0].frames[0].frame_number
+        for index, response in enumerate(responses):
+            self.check_frames(response.frames, session_id, first + index)
+        self.assertAlmostEqual(responses[-1].frames[0].sim_time_s
+                               - responses[0].frames[0].sim_time_s, 4 * DT)
+
+    def run_lockstep(self, seed, steps=4):
+        """For each step, the SHA-256 of each view's JPEG."""
+        session_id = self.open_session(seed=seed)
+        return [{f.view: hashlib.sha256(f.jpeg).hexdigest()
+                 for f in self.client.step(session_id, DT, inputs(step))}
+                for step in range(1, steps + 1)]
+
+    def test_lockstep_is_deterministic(self):
+        first, second = self.run_lockstep(seed=42), self.run_lockstep(seed=42)
+        for step, (a, b) in enumerate(zip(first, second), start=1):
+            for view in SIZES:
+                self.assertEqual(a[view], b[view], f"step {step}, view {pb.View.Name(view)}")
+
+    def test_seed_changes_frames(self):
+        first, other = self.run_lockstep(seed=42), self.run_lockstep(seed=43)
+        self.assertNotEqual(first, other)
+
+    def test_realtime_frames_stream_to_a_watcher(self):
+        session_id = self.open_session(views=[VIEWS[0]], mode=pb.MODE_REALTIME, fps=20)
+        call = self.client.watch_frames(session_id)
+        timer = threading.Timer(1.0, call.cancel)
+        timer.start()
+        numbers = []
+        try:
+            for frame in call:
+                self.assertEqual(frame.view, pb.VIEW_COCKPIT)
+                self.assertEqual(image_size(frame.jpeg), ("JPEG", (160, 90)))
+                numbers.append(frame.frame_number)
+        except grpc.RpcError as error:
+            self.assertEqual(error.code(), grpc.StatusCode.CANCELLED)
+        finally:
+            timer.cancel()
+        self.assertGreaterEqual(len(numbers), 5, numbers)
+        self.assertEqual(numbers, sorted(set(numbers)))
+
+    def assert_status(self, code, field, call, *args, **kwargs):
+        with self.assertRaises(grpc.RpcError) as caught:
+            call(*args, **kwargs)
+        self.assertEqual(caught.exception.code(), code, caught.exception.details())
+        if field:
+            self.assertIn(field, caught.exception.details())
+
+    def test_bad_input_gets_a_clear_status_and_the_server_keeps_serving(self):
+        invalid = grpc.StatusCode.INVALID_ARGUMENT
+        create = self.client.create_session
+        for rain in (600.0, math.nan, -1.0):
+            bad = inputs(0)
+            bad.weather.rain_rate_mm_h = rain
+            self.assert_status(invalid, "rain_rate_mm_h", create, VIEWS, initial=bad)
+        self.assert_status(invalid, "width", create, [view_spec("COCKPIT", 0, 90)])
+        self.assert_status(invalid, "width", create, [view_spec("COCKPIT", 100000, 90)])
+        self.assert_status(invalid, "jpeg_quality", create, [view_spec("ROAD", 64, 64, 101)])
+        self.assert_status(invalid, "view", create, [view_spec(42, 64, 64)])
+        self.assert_status(invalid, "view", create, [VIEWS[0], VIEWS[0]])
+        self.assert_status(invalid, "views", create, [])
+        self.assert_status(invalid, "mode", create, VIEWS, mode=9)
+
+        session_id = self.open_session()
+        nan_update = inputs(1)
+        nan_update.weather.rain_rate_mm_h = math.nan
+        self.assert_status(invalid, "rain_rate_mm_h", self.client.step, session_id, DT,
+                           nan_update)
+        self.assert_status(invalid, "rain_rate_mm_h", self.client.update, session_id,
+                           nan_update)
+        self.assert_status(invalid, "dt_s", self.client.step, session_id, -1.0)
+        self.assert_status(invalid, "dt_s", self.client.step, session_id, 0.0)
+        self.assert_status(grpc.StatusCode.NOT_FOUND, None, self.client.step, "no-such-session",
+                           DT)
+        realtime = self.open_session(views=[view_spec("RAIN", 32, 32)], mode=pb.MODE_REALTIME)
+        self.assert_status(grpc.StatusCode.FAILED_PRECONDITION, None, self.client.step,
+                           realtime, DT)
+
+        listed = [s.session_id for s in self.client.list_sessions()]
+        self.assertIn(session_id, listed)
+        frames = self.client.step(session_id, DT, inputs(1))
+        self.check_frames(frames, session_id, frames[0].frame_number)
+
+    def test_session_limit(self):
+        opened = len(self.client.list_sessions())
+        small = [view_spec("RAIN", 16, 16)]
+        with self.assertRaises(grpc.RpcError) as caught:
+            for _ in range(8 - opened + 1):
+                self.open_session(views=small)
+        self.assertEqual(caught.exception.code(), grpc.StatusCode.RESOURCE_EXHAUSTED)
+        self.assertEqual(len(self.client.list_sessions()), 8)
+        self.client.close_session(self.client.list_sessions()[0].session_id)
+        self.open_session(views=small)  # room again
+
+    def test_cli_plays_a_scenario(self):
+        scenario = {
+            "name": "cli", "duration_s": 1.0, "seed": 3, "fps": 20,
+            "views": [{"view": "COCKPIT", "width": 160, "height": 90},
+                      {"view": "ROAD", "width": 128, "height": 72}],
+            "keyframes": [{"t": 0.0, "weather": {"rain_rate_mm_h": 10},
+                           "wipers": {"mode": "LOW"}},
+                          {"t": 1.0, "weather": {"rain_rate_mm_h": 30}}],
+        }
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "scenario.json")
+            with open(path, "w") as file:
+                json.dump(scenario, file)
+            out = os.path.join(folder, "frames")
+            result = subprocess.run(
+                [sys.executable, "-m", "downpour_client", "play", path, "--server", self.target,
+                 "--frames", "3", "--out", out],
+                env=dict(os.environ, PYTHONPATH=os.path.join(REPO, "clients", "python")),
+                capture_output=True, text=True, timeout=60)
+            self.assertEqual(result.returncode, 0, result.stderr)
+            session_id = result.stdout.splitlines()[0].split("=", 1)[1]
+            self.assertRegex(result.stdout.splitlines()[-1], r"^frames=3 images=6 ")
+            names = sorted(os.listdir(out))
+            self.assertEqual(len(names), 6)
+            with open(os.path.join(out, names[0]), "rb") as file:
+                self.assertEqual(image_size(file.read()), ("JPEG", (160, 90)))
+        self.assertNotIn(session_id, [s.session_id for s in self.client.list_sessions()])
+
+
+if __name__ == "__main__":
+    unittest.main()

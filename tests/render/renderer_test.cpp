@@ -1,0 +1,123 @@
+// Render tests on llvmpipe: each view against a golden PNG, and properties a golden file cannot
+// fake. Set DOWNPOUR_UPDATE_GOLDEN=1 to rewrite the golden files after a deliberate change (then
+// look at them).
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+
+#include <gtest/gtest.h>
+
+#include "server/render/renderer.hpp"
+#include "server/sim/scenario.hpp"
+#include "server/sim/simulation.hpp"
+#include "tests/support/png_io.hpp"
+
+namespace downpour::render {
+namespace {
+
+using testing::RgbaImage;
+
+constexpr int kWidth = 256;
+constexpr int kHeight = 144;
+
+class RendererTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { renderer_ = Renderer::create({}).release(); }
+  static void TearDownTestSuite() {
+    delete renderer_;
+    renderer_ = nullptr;
+  }
+
+  // The highway scene 10 s in: on the straight, heavy rain.
+  static sim::SceneState highway_scene(double rain_mm_h = 25.0, double cloudiness = 0.95) {
+    const sim::Scenario scenario = sim::highway_heavy_rain();
+    sim::Update update = scenario.at(10.0);
+    update.weather->rain_rate_mm_h = rain_mm_h;
+    update.weather->cloudiness = cloudiness;
+    sim::Simulation simulation(scenario.seed, update);
+    simulation.advance(10.0);
+    return simulation.state();
+  }
+
+  static RgbaImage render(sim::View view, const sim::SceneState& scene) {
+    const sim::ViewSpec spec{view, kWidth, kHeight, 85, 0.0, std::nullopt};
+    return {kWidth, kHeight, render_image(*renderer_, spec, scene)};
+  }
+
+  static Renderer* renderer_;
+};
+Renderer* RendererTest::renderer_ = nullptr;
+
+class GoldenTest : public RendererTest, public ::testing::WithParamInterface<sim::View> {};
+
+TEST_P(GoldenTest, MatchesGoldenImage) {
+  const sim::View view = GetParam();
+  const RgbaImage image = render(view, highway_scene());
+  const std::string name = std::string(sim::view_name(view)) + ".png";
+  const std::string golden = std::string(DOWNPOUR_GOLDEN_DIR) + "/" + name;
+  if (std::getenv("DOWNPOUR_UPDATE_GOLDEN")) {
+    testing::write_png(golden, image);
+    GTEST_SKIP() << "wrote " << golden;
+  }
+  ASSERT_TRUE(std::filesystem::exists(golden)) << golden << " is missing; run with DOWNPOUR_UPDATE_GOLDEN=1";
+  const double db = testing::psnr(image, testing::read_png(golden));
+  if (db < 32.0) {
+    const std::string actual = ::testing::TempDir() + "actual_" + name;
+    testing::write_png(actual, image);
+    ADD_FAILURE() << name << ": PSNR " << db << " dB against the golden image; this render: " << actual;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Views, GoldenTest,
+                         ::testing::Values(sim::View::kCockpit, sim::View::kRoad, sim::View::kWindshield,
+                                           sim::View::kRain),
+                         [](const auto& info) { return std::string(sim::view_name(info.param)); });
+
+TEST_F(RendererTest, SkyDarkensAsTheRainRateRises) {
+  double previous = 1e9;
+  for (double rain : {0.0, 2.0, 10.0, 50.0, 200.0}) {
+    const RgbaImage image = render(sim::View::kRoad, highway_scene(rain, 0.3));
+    // The top fifth of the chase view is sky.
+    const double sky = testing::mean_luma(image, 0, 0, kWidth, kHeight / 5);
+    EXPECT_LT(sky, previous) << "rain " << rain << " mm/h";
+    previous = sky;
+  }
+}
+
+TEST_F(RendererTest, WetAsphaltIsDarkerThanDry) {
+  // The road just ahead of the car in the chase view, between the lane lines, below the car.
+  const auto road = [&](double rain) {
+    const RgbaImage image = render(sim::View::kRoad, highway_scene(rain, 0.6));
+    return testing::mean_luma(image, kWidth / 8, kHeight * 7 / 8, kWidth / 3, kHeight);
+  };
+  EXPECT_LT(road(25.0), road(0.0) * 0.9);
+}
+
+TEST_F(RendererTest, CockpitShowsTheDashboardBelowTheGlass) {
+  const RgbaImage image = render(sim::View::kCockpit, highway_scene(0.0, 0.2));
+  const double dashboard = testing::mean_luma(image, kWidth / 3, kHeight * 9 / 10, kWidth * 2 / 3, kHeight);
+  const double through_glass = testing::mean_luma(image, kWidth / 3, kHeight / 4, kWidth * 2 / 3, kHeight / 2);
+  EXPECT_LT(dashboard, through_glass * 0.5);
+}
+
+TEST_F(RendererTest, DryWindshieldViewIsTheOutlineOnBlack) {
+  const RgbaImage image = render(sim::View::kWindshield, highway_scene());
+  int lit = 0;
+  for (std::size_t i = 0; i < image.pixels.size(); i += 4) lit += image.pixels[i] > 10;
+  const int total = kWidth * kHeight;
+  EXPECT_GT(lit, total / 200);  // the outline is there
+  EXPECT_LT(lit, total / 10);   // and nothing else: no water on dry glass
+}
+
+TEST_F(RendererTest, RainViewIsBlackWithoutRainEffects) {
+  const RgbaImage image = render(sim::View::kRain, highway_scene());
+  EXPECT_LT(testing::mean_luma(image), 0.01);
+}
+
+TEST_F(RendererTest, SameSceneRendersTheSamePixels) {
+  const sim::SceneState scene = highway_scene();
+  EXPECT_EQ(render(sim::View::kCockpit, scene).pixels, render(sim::View::kCockpit, scene).pixels);
+}
+
+}  // namespace
+}  // namespace downpour::render
