@@ -43,13 +43,16 @@ class Renderer {
   const std::string& gl_renderer() const;
   const std::string& platform() const;
 
-  // glFinish after each pass, so that pass timings are real (benchmarks); off in service.
+  // glFinish after each pass, so that pass timings are real (benchmarks); off in service. On
+  // llvmpipe a finish mid-frame leaves the context several times slower from then on, so profile
+  // with a renderer of its own and take the times as a ranking of the passes.
   void set_profiling(bool on);
   const std::vector<PassTiming>& last_pass_timings() const;
 
   // Renders a view into the render target named target_key (made on first use, remade when the
   // size changes) and starts its readback.
-  PendingReadback render(std::uint64_t target_key, const sim::ViewSpec& spec, const sim::SceneState& scene);
+  PendingReadback render(std::uint64_t target_key, const sim::ViewSpec& spec,
+                         const sim::SceneState& scene);
   bool is_ready(const PendingReadback& pending) const;
   // Waits if needed; out gets RGBA8 rows bottom-up.
   void finish(const PendingReadback& pending, std::vector<std::uint8_t>& out);
@@ -63,6 +66,7 @@ class Renderer {
 };
 
 // Renders one view and waits for its pixels, rows top-down (tests, tools).
-std::vector<std::uint8_t> render_image(Renderer& renderer, const sim::ViewSpec& spec, const sim::SceneState& scene);
+std::vector<std::uint8_t> render_image(Renderer& renderer, const sim::ViewSpec& spec,
+                                       const sim::SceneState& scene);
 
 }  // namespace downpour::render

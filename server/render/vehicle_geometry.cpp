@@ -60,8 +60,8 @@ MeshData build_cockpit_interior(const WindshieldCorners& g) {
   m.add_face({g.top_right.x + 0.02f, -0.9f, g.top_right.z}, {g.top_left.x + 0.02f, 0.9f, g.top_left.z},
              {0.2f, 0.9f, g.top_left.z + 0.06f}, {0.2f, -0.9f, g.top_right.z + 0.06f}, material::kTrim);
   // Rear-view mirror on a short stem.
-  m.add_box({1.5f, -0.11f, 1.25f}, {1.53f, 0.11f, 1.31f}, material::kBody);
-  m.add_box({1.47f, -0.012f, 1.31f}, {1.49f, 0.012f, 1.37f}, material::kTrim);
+  m.add_box({1.55f, -0.09f, 1.27f}, {1.57f, 0.09f, 1.32f}, material::kBody);
+  m.add_box({1.5f, -0.012f, 1.32f}, {1.52f, 0.012f, 1.37f}, material::kTrim);
   return m;
 }
 

@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <stdexcept>
 
+#include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
 #include "server/sim/track.hpp"
@@ -39,8 +42,8 @@ Weather mix(const Weather& a, const Weather& b, double u) {
   w.cloudiness = lerp(a.cloudiness, b.cloudiness, u);
   w.sun_altitude_deg = lerp(a.sun_altitude_deg, b.sun_altitude_deg, u);
   w.sun_azimuth_deg = lerp_angle_deg(a.sun_azimuth_deg, b.sun_azimuth_deg, u);
-  w.rain_streak_count = static_cast<std::uint32_t>(
-      std::lround(lerp(a.rain_streak_count, b.rain_streak_count, u)));
+  w.rain_streak_count =
+      static_cast<std::uint32_t>(std::lround(lerp(a.rain_streak_count, b.rain_streak_count, u)));
   w.rain_angle_deg = lerp(a.rain_angle_deg, b.rain_angle_deg, u);
   return w;
 }
@@ -69,12 +72,18 @@ std::optional<T> sample(const std::vector<Keyframe>& keys, std::optional<T> Keyf
 
 const char* wiper_mode_name(WiperMode m) {
   switch (m) {
-    case WiperMode::kOff: return "OFF";
-    case WiperMode::kIntermittent: return "INTERMITTENT";
-    case WiperMode::kLow: return "LOW";
-    case WiperMode::kHigh: return "HIGH";
-    case WiperMode::kSingle: return "SINGLE";
-    case WiperMode::kManual: return "MANUAL";
+    case WiperMode::kOff:
+      return "OFF";
+    case WiperMode::kIntermittent:
+      return "INTERMITTENT";
+    case WiperMode::kLow:
+      return "LOW";
+    case WiperMode::kHigh:
+      return "HIGH";
+    case WiperMode::kSingle:
+      return "SINGLE";
+    case WiperMode::kManual:
+      return "MANUAL";
   }
   return "OFF";
 }
@@ -83,22 +92,81 @@ const char* wiper_mode_name(WiperMode m) {
   throw std::runtime_error("scenario " + field + ": " + what);
 }
 
+std::string join(const std::string& where, const char* key) {
+  return where.empty() ? std::string(key) : where + "." + key;
+}
+
 double number(const json& j, const char* key, const std::string& where, double fallback) {
   if (!j.contains(key)) return fallback;
   const json& v = j.at(key);
-  if (!v.is_number()) fail(where + "." + key, "must be a number");
+  if (!v.is_number()) fail(join(where, key), "must be a number");
   const double d = v.get<double>();
-  if (!std::isfinite(d)) fail(where + "." + key, "must be finite");
+  if (!std::isfinite(d)) fail(join(where, key), "must be finite");
   return d;
+}
+
+// A whole number in [lo, hi]; a fraction or anything outside is refused rather than cast.
+std::int64_t integer(const json& j, const char* key, const std::string& where,
+                     std::int64_t fallback, std::int64_t lo, std::int64_t hi) {
+  const double d = number(j, key, where, static_cast<double>(fallback));
+  if (d < static_cast<double>(lo) || d > static_cast<double>(hi) || d != std::floor(d)) {
+    fail(join(where, key),
+         "must be a whole number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  return static_cast<std::int64_t>(d);
+}
+
+std::string text(const json& j, const char* key, const std::string& where,
+                 const std::string& fallback) {
+  if (!j.contains(key)) return fallback;
+  const json& v = j.at(key);
+  if (!v.is_string()) fail(join(where, key), "must be a string");
+  return v.get<std::string>();
+}
+
+bool flag(const json& j, const char* key, const std::string& where, bool fallback) {
+  if (!j.contains(key)) return fallback;
+  const json& v = j.at(key);
+  if (!v.is_boolean()) fail(join(where, key), "must be true or false");
+  return v.get<bool>();
+}
+
+// An object member that must be an object (or absent: nullptr).
+const json* object(const json& j, const char* key, const std::string& where) {
+  if (!j.contains(key)) return nullptr;
+  const json& v = j.at(key);
+  if (!v.is_object()) fail(join(where, key), "must be an object");
+  return &v;
+}
+
+const json& array(const json& j, const char* key, const std::string& where) {
+  static const json kEmpty = json::array();
+  if (!j.contains(key)) return kEmpty;
+  const json& v = j.at(key);
+  if (!v.is_array()) fail(join(where, key), "must be an array");
+  return v;
+}
+
+std::vector<double> numbers(const json& j, const char* key, const std::string& where) {
+  std::vector<double> out;
+  const json& v = array(j, key, where);
+  for (const json& x : v) {
+    if (!x.is_number() || !std::isfinite(x.get<double>()))
+      fail(join(where, key), "must be an array of numbers");
+    out.push_back(x.get<double>());
+  }
+  return out;
 }
 
 glm::dvec3 vec3(const json& j, const char* key, const std::string& where) {
   if (!j.contains(key)) return glm::dvec3(0.0);
   const json& v = j.at(key);
-  if (!v.is_array() || v.size() != 3) fail(where + "." + key, "must be an array of 3 numbers");
+  if (!v.is_array() || v.size() != 3) fail(join(where, key), "must be an array of 3 numbers");
   glm::dvec3 out;
   for (int i = 0; i < 3; ++i) {
-    if (!v[i].is_number()) fail(where + "." + key, "must be an array of 3 numbers");
+    if (!v[i].is_number() || !std::isfinite(v[i].get<double>())) {
+      fail(join(where, key), "must be an array of 3 finite numbers");
+    }
     out[i] = v[i].get<double>();
   }
   return out;
@@ -129,8 +197,9 @@ Update Scenario::at(double t_in) const {
   }
   Update u;
   u.client_time_s = t_in;
-  u.vehicle = sample(keyframes, &Keyframe::vehicle, t,
-                     [](const VehicleState& a, const VehicleState& b, double w) { return mix(a, b, w); });
+  u.vehicle =
+      sample(keyframes, &Keyframe::vehicle, t,
+             [](const VehicleState& a, const VehicleState& b, double w) { return mix(a, b, w); });
   u.weather = sample(keyframes, &Keyframe::weather, t,
                      [](const Weather& a, const Weather& b, double w) { return mix(a, b, w); });
   u.wipers = sample(keyframes, &Keyframe::wipers, t,
@@ -138,70 +207,75 @@ Update Scenario::at(double t_in) const {
   return u;
 }
 
-Scenario Scenario::from_json(const std::string& text) {
+Scenario Scenario::from_json(const std::string& source) {
   json root;
   try {
-    root = json::parse(text);
-  } catch (const json::parse_error& e) {
+    root = json::parse(source);
+  } catch (const json::exception& e) {  // syntax errors, and numbers too large for a double
     fail("file", std::string("is not valid JSON: ") + e.what());
   }
   if (!root.is_object()) fail("file", "must be a JSON object");
   Scenario s;
-  s.name = root.value("name", "");
-  s.description = root.value("description", "");
+  s.name = text(root, "name", "", "");
+  s.description = text(root, "description", "", "");
   s.duration_s = number(root, "duration_s", "", 0.0);
-  s.loop = root.value("loop", false);
-  s.seed = root.value("seed", std::uint64_t{0});
+  if (s.duration_s < 0.0) fail("duration_s", "must not be negative");
+  s.loop = flag(root, "loop", "", false);
+  s.seed = static_cast<std::uint64_t>(integer(root, "seed", "", 0, 0, std::int64_t{1} << 53));
   s.fps = number(root, "fps", "", 30.0);
   if (s.fps <= 0.0) fail("fps", "must be positive");
-  for (std::size_t i = 0; i < root.value("views", json::array()).size(); ++i) {
-    const json& jv = root["views"][i];
+  const json& views = array(root, "views", "");
+  for (std::size_t i = 0; i < views.size(); ++i) {
     const std::string where = "views[" + std::to_string(i) + "]";
+    const json& jv = views[i];
+    if (!jv.is_object()) fail(where, "must be an object");
     ViewSpec v;
-    v.view = parse_view(jv.value("view", ""), where + ".view");
-    v.width = static_cast<int>(number(jv, "width", where, 640));
-    v.height = static_cast<int>(number(jv, "height", where, 360));
-    v.jpeg_quality = static_cast<int>(number(jv, "jpeg_quality", where, 85));
+    v.view = parse_view(text(jv, "view", where, ""), where + ".view");
+    v.width = static_cast<int>(integer(jv, "width", where, 640, 1, 1 << 16));
+    v.height = static_cast<int>(integer(jv, "height", where, 360, 1, 1 << 16));
+    v.jpeg_quality = static_cast<int>(integer(jv, "jpeg_quality", where, 85, 1, 100));
     v.fov_deg = number(jv, "fov_deg", where, 0.0);
     s.views.push_back(v);
   }
-  const json keys = root.value("keyframes", json::array());
+  const json& keys = array(root, "keyframes", "");
   for (std::size_t i = 0; i < keys.size(); ++i) {
-    const json& jk = keys[i];
     const std::string where = "keyframes[" + std::to_string(i) + "]";
+    const json& jk = keys[i];
+    if (!jk.is_object()) fail(where, "must be an object");
     Keyframe k;
     k.t = number(jk, "t", where, 0.0);
-    if (!s.keyframes.empty() && k.t < s.keyframes.back().t) fail(where + ".t", "keyframes must be sorted by t");
-    if (jk.contains("vehicle")) {
-      const json& jv = jk["vehicle"];
+    if (!s.keyframes.empty() && k.t < s.keyframes.back().t)
+      fail(where + ".t", "keyframes must be sorted by t");
+    if (const json* jv = object(jk, "vehicle", where)) {
+      const std::string wv = where + ".vehicle";
       VehicleState v;
-      v.position_m = vec3(jv, "position_m", where + ".vehicle");
-      const glm::dvec3 r = vec3(jv, "rotation_deg", where + ".vehicle");
+      v.position_m = vec3(*jv, "position_m", wv);
+      const glm::dvec3 r = vec3(*jv, "rotation_deg", wv);
       v.rotation = {r.x, r.y, r.z};
-      v.velocity_mps = vec3(jv, "velocity_mps", where + ".vehicle");
+      v.velocity_mps = vec3(*jv, "velocity_mps", wv);
       k.vehicle = v;
     }
-    if (jk.contains("wipers")) {
-      const json& jw = jk["wipers"];
+    if (const json* jw = object(jk, "wipers", where)) {
+      const std::string ww = where + ".wipers";
       WiperState w;
-      w.mode = parse_wiper_mode(jw.value("mode", "OFF"), where + ".wipers.mode");
-      w.interval_s = number(jw, "interval_s", where + ".wipers", 4.0);
-      w.blade_angle_deg = jw.value("blade_angle_deg", std::vector<double>{});
+      w.mode = parse_wiper_mode(text(*jw, "mode", ww, "OFF"), ww + ".mode");
+      w.interval_s = number(*jw, "interval_s", ww, 4.0);
+      w.blade_angle_deg = numbers(*jw, "blade_angle_deg", ww);
       k.wipers = w;
     }
-    if (jk.contains("weather")) {
-      const json& jw = jk["weather"];
+    if (const json* jw = object(jk, "weather", where)) {
       const std::string ww = where + ".weather";
       Weather w;
-      w.rain_rate_mm_h = number(jw, "rain_rate_mm_h", ww, w.rain_rate_mm_h);
-      w.wind_speed_mps = number(jw, "wind_speed_mps", ww, w.wind_speed_mps);
-      w.wind_direction_deg = number(jw, "wind_direction_deg", ww, w.wind_direction_deg);
-      w.fog_density = number(jw, "fog_density", ww, w.fog_density);
-      w.cloudiness = number(jw, "cloudiness", ww, w.cloudiness);
-      w.sun_altitude_deg = number(jw, "sun_altitude_deg", ww, w.sun_altitude_deg);
-      w.sun_azimuth_deg = number(jw, "sun_azimuth_deg", ww, w.sun_azimuth_deg);
-      w.rain_streak_count = static_cast<std::uint32_t>(number(jw, "rain_streak_count", ww, 0));
-      w.rain_angle_deg = number(jw, "rain_angle_deg", ww, w.rain_angle_deg);
+      w.rain_rate_mm_h = number(*jw, "rain_rate_mm_h", ww, w.rain_rate_mm_h);
+      w.wind_speed_mps = number(*jw, "wind_speed_mps", ww, w.wind_speed_mps);
+      w.wind_direction_deg = number(*jw, "wind_direction_deg", ww, w.wind_direction_deg);
+      w.fog_density = number(*jw, "fog_density", ww, w.fog_density);
+      w.cloudiness = number(*jw, "cloudiness", ww, w.cloudiness);
+      w.sun_altitude_deg = number(*jw, "sun_altitude_deg", ww, w.sun_altitude_deg);
+      w.sun_azimuth_deg = number(*jw, "sun_azimuth_deg", ww, w.sun_azimuth_deg);
+      w.rain_streak_count = static_cast<std::uint32_t>(
+          integer(*jw, "rain_streak_count", ww, 0, 0, std::numeric_limits<std::uint32_t>::max()));
+      w.rain_angle_deg = number(*jw, "rain_angle_deg", ww, w.rain_angle_deg);
       k.weather = w;
     }
     s.keyframes.push_back(std::move(k));
@@ -219,8 +293,11 @@ std::string Scenario::to_json() const {
   root["fps"] = fps;
   root["views"] = json::array();
   for (const ViewSpec& v : views) {
-    root["views"].push_back({{"view", view_name(v.view)}, {"width", v.width}, {"height", v.height},
-                             {"jpeg_quality", v.jpeg_quality}, {"fov_deg", v.fov_deg}});
+    root["views"].push_back({{"view", view_name(v.view)},
+                             {"width", v.width},
+                             {"height", v.height},
+                             {"jpeg_quality", v.jpeg_quality},
+                             {"fov_deg", v.fov_deg}});
   }
   root["keyframes"] = json::array();
   auto round_to = [](double x, double unit) { return std::round(x / unit) * unit; };
@@ -233,7 +310,8 @@ std::string Scenario::to_json() const {
         return json::array({round_to(x.x, unit), round_to(x.y, unit), round_to(x.z, unit)});
       };
       jk["vehicle"] = {{"position_m", arr(v.position_m, 1e-4)},
-                       {"rotation_deg", arr({v.rotation.yaw_deg, v.rotation.pitch_deg, v.rotation.roll_deg}, 1e-4)},
+                       {"rotation_deg",
+                        arr({v.rotation.yaw_deg, v.rotation.pitch_deg, v.rotation.roll_deg}, 1e-4)},
                        {"velocity_mps", arr(v.velocity_mps, 1e-4)}};
     }
     if (k.wipers) {
@@ -243,10 +321,14 @@ std::string Scenario::to_json() const {
     }
     if (k.weather) {
       const Weather& w = *k.weather;
-      jk["weather"] = {{"rain_rate_mm_h", w.rain_rate_mm_h},   {"wind_speed_mps", w.wind_speed_mps},
-                       {"wind_direction_deg", w.wind_direction_deg}, {"fog_density", w.fog_density},
-                       {"cloudiness", w.cloudiness},           {"sun_altitude_deg", w.sun_altitude_deg},
-                       {"sun_azimuth_deg", w.sun_azimuth_deg}, {"rain_streak_count", w.rain_streak_count},
+      jk["weather"] = {{"rain_rate_mm_h", w.rain_rate_mm_h},
+                       {"wind_speed_mps", w.wind_speed_mps},
+                       {"wind_direction_deg", w.wind_direction_deg},
+                       {"fog_density", w.fog_density},
+                       {"cloudiness", w.cloudiness},
+                       {"sun_altitude_deg", w.sun_altitude_deg},
+                       {"sun_azimuth_deg", w.sun_azimuth_deg},
+                       {"rain_streak_count", w.rain_streak_count},
                        {"rain_angle_deg", w.rain_angle_deg}};
     }
     root["keyframes"].push_back(jk);
@@ -256,20 +338,46 @@ std::string Scenario::to_json() const {
 
 namespace {
 
-// Keyframes that drive the test track's lane at a constant speed, one lap, every step_s seconds.
+// Where a lane's centre is at centreline arc length s.
+glm::dvec3 lane_point(const Track& track, double s, double lateral) {
+  const TrackFrame f = track.at(s);
+  glm::dvec3 p = f.position + glm::dvec3(f.left * lateral, 0.0);
+  p.z = track.surface_height(s, lateral);
+  return p;
+}
+
+// Keyframes that drive one lane of the test track at a constant speed, one lap, every step_s
+// seconds. The lane is longer than the centreline on the curves (outer lane) or shorter (inner),
+// so the distance travelled is measured along the lane itself: a table of centreline s against
+// lane distance, inverted by interpolation.
 std::vector<Keyframe> drive_lap(const Track& track, int lane, double speed_mps, double step_s) {
-  std::vector<Keyframe> keys;
-  const double lap_s = track.length() / speed_mps;
   const double lateral = track.lane_centre(lane);
+  constexpr double kTableStep = 0.25;  // metres of centreline
+  const int n = static_cast<int>(std::ceil(track.length() / kTableStep));
+  std::vector<double> lane_distance(n + 1, 0.0);
+  glm::dvec3 previous = lane_point(track, 0.0, lateral);
+  for (int i = 1; i <= n; ++i) {
+    const glm::dvec3 p = lane_point(track, track.length() * i / n, lateral);
+    lane_distance[i] = lane_distance[i - 1] + glm::length(p - previous);
+    previous = p;
+  }
+  auto centreline_s = [&](double d) {
+    const auto it = std::lower_bound(lane_distance.begin(), lane_distance.end(), d);
+    const auto i = std::clamp<std::ptrdiff_t>(it - lane_distance.begin(), 1, n);
+    const double w = (d - lane_distance[i - 1]) / (lane_distance[i] - lane_distance[i - 1]);
+    return track.length() * (static_cast<double>(i - 1) + std::clamp(w, 0.0, 1.0)) / n;
+  };
+
+  std::vector<Keyframe> keys;
+  const double lap_s = lane_distance.back() / speed_mps;
   // Whole steps of about step_s, so that the last keyframe closes the loop onto the first.
   const int steps = static_cast<int>(std::ceil(lap_s / step_s));
   for (int i = 0; i <= steps; ++i) {
     const double t = lap_s * i / steps;
-    const double s = speed_mps * t;
+    const double s = i == steps ? track.length() : centreline_s(speed_mps * t);
     const TrackFrame f = track.at(s);
     VehicleState v;
-    v.position_m = f.position + glm::dvec3(f.left * lateral, 0.0);
-    v.position_m.z = track.surface_height(s, lateral);
+    v.position_m = lane_point(track, s, lateral);
     v.rotation.yaw_deg = std::remainder(f.heading_rad * 180.0 / M_PI, 360.0);
     v.rotation.pitch_deg = -std::atan(f.grade) * 180.0 / M_PI;
     const glm::dvec2 dir(std::cos(f.heading_rad), std::sin(f.heading_rad));
@@ -285,11 +393,13 @@ Scenario highway_heavy_rain() {
   const Track track = Track::test_track();
   Scenario s;
   s.name = "highway_heavy_rain";
-  s.description = "The test track's outer lane at 25 m/s in 25 mm/h rain, wipers on high, overcast.";
+  s.description =
+      "The test track's outer lane at 25 m/s in 25 mm/h rain, wipers on high, overcast.";
   s.loop = true;
   s.seed = 7;
   s.fps = 30.0;
-  s.views = {{View::kCockpit, 640, 360, 85, 0.0, std::nullopt}, {View::kRoad, 640, 360, 85, 0.0, std::nullopt}};
+  s.views = {{View::kCockpit, 640, 360, 85, 0.0, std::nullopt},
+             {View::kRoad, 640, 360, 85, 0.0, std::nullopt}};
   s.keyframes = drive_lap(track, 1, 25.0, 0.5);
   s.duration_s = s.keyframes.back().t;
   Weather w;
@@ -313,7 +423,8 @@ Scenario city_drizzle() {
   s.loop = true;
   s.seed = 11;
   s.fps = 30.0;
-  s.views = {{View::kCockpit, 640, 360, 85, 0.0, std::nullopt}, {View::kRoad, 640, 360, 85, 0.0, std::nullopt}};
+  s.views = {{View::kCockpit, 640, 360, 85, 0.0, std::nullopt},
+             {View::kRoad, 640, 360, 85, 0.0, std::nullopt}};
   s.keyframes = drive_lap(track, 0, 8.0, 1.0);
   s.duration_s = s.keyframes.back().t;
   Weather w;

@@ -1,0 +1,320 @@
+#include "server/rpc/validation.hpp"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace downpour::rpc {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// An INVALID_ARGUMENT whose message names the field.
+::testing::AssertionResult invalid_naming(const grpc::Status& status, const std::string& field) {
+  if (status.error_code() != grpc::StatusCode::INVALID_ARGUMENT) {
+    return ::testing::AssertionFailure()
+           << "code " << status.error_code() << " (" << status.error_message() << ")";
+  }
+  if (status.error_message().find(field) == std::string::npos) {
+    return ::testing::AssertionFailure()
+           << "'" << status.error_message() << "' does not name '" << field << "'";
+  }
+  return ::testing::AssertionSuccess();
+}
+
+v1::ViewSpec view(v1::View v, int width = 640, int height = 360) {
+  v1::ViewSpec spec;
+  spec.set_view(v);
+  spec.set_width(width);
+  spec.set_height(height);
+  return spec;
+}
+
+v1::CreateSessionRequest good_request() {
+  v1::CreateSessionRequest r;
+  *r.add_views() = view(v1::VIEW_COCKPIT);
+  return r;
+}
+
+grpc::Status create(const v1::CreateSessionRequest& r) {
+  session::SessionConfig config;
+  sim::Update initial;
+  return to_session_config(r, Limits{}, &config, &initial);
+}
+
+grpc::Status update(const v1::Update& u) {
+  sim::Update out;
+  return to_update(u, "update", Limits{}, &out);
+}
+
+TEST(ValidationTest, NonFiniteVehiclePosition) {
+  for (double bad : {kNaN, kInf, -kInf}) {
+    v1::Update u;
+    u.mutable_vehicle()->mutable_position_m()->set_y(bad);
+    EXPECT_TRUE(invalid_naming(update(u), "update.vehicle.position_m.y")) << bad;
+  }
+  v1::CreateSessionRequest r = good_request();
+  r.mutable_initial()->mutable_vehicle()->mutable_position_m()->set_x(kNaN);
+  EXPECT_TRUE(invalid_naming(create(r), "initial.vehicle.position_m.x"));
+}
+
+TEST(ValidationTest, RainRateOutOfRange) {
+  for (double bad : {600.0, -1.0, kNaN}) {
+    v1::Update u;
+    u.mutable_weather()->set_rain_rate_mm_h(bad);
+    EXPECT_TRUE(invalid_naming(update(u), "update.weather.rain_rate_mm_h")) << bad;
+  }
+  v1::Update ok;
+  ok.mutable_weather()->set_rain_rate_mm_h(500.0);
+  EXPECT_TRUE(update(ok).ok());
+}
+
+TEST(ValidationTest, ViewSizeOutOfRange) {
+  for (int width : {0, 15, 100000}) {
+    v1::CreateSessionRequest r;
+    *r.add_views() = view(v1::VIEW_COCKPIT, width, 360);
+    EXPECT_TRUE(invalid_naming(create(r), "views[0].width")) << width;
+  }
+  v1::CreateSessionRequest r;
+  *r.add_views() = view(v1::VIEW_ROAD);
+  *r.add_views() = view(v1::VIEW_RAIN, 640, Limits{}.max_height + 1);
+  EXPECT_TRUE(invalid_naming(create(r), "views[1].height"));
+  r.mutable_views(1)->set_height(Limits{}.max_height);
+  EXPECT_TRUE(create(r).ok());
+}
+
+TEST(ValidationTest, JpegQualityAboveOneHundred) {
+  v1::CreateSessionRequest r = good_request();
+  r.mutable_views(0)->set_jpeg_quality(101);
+  EXPECT_TRUE(invalid_naming(create(r), "views[0].jpeg_quality"));
+}
+
+TEST(ValidationTest, UnknownEnumValues) {
+  v1::CreateSessionRequest bad_view = good_request();
+  bad_view.mutable_views(0)->set_view(static_cast<v1::View>(42));
+  EXPECT_TRUE(invalid_naming(create(bad_view), "views[0].view"));
+
+  v1::CreateSessionRequest unspecified_view = good_request();
+  unspecified_view.mutable_views(0)->set_view(v1::VIEW_UNSPECIFIED);
+  EXPECT_TRUE(invalid_naming(create(unspecified_view), "views[0].view"));
+
+  v1::CreateSessionRequest bad_mode = good_request();
+  bad_mode.set_mode(static_cast<v1::Mode>(9));
+  EXPECT_TRUE(invalid_naming(create(bad_mode), "mode"));
+
+  v1::Update bad_wipers;
+  bad_wipers.mutable_wipers()->set_mode(static_cast<v1::WiperMode>(77));
+  EXPECT_TRUE(invalid_naming(update(bad_wipers), "update.wipers.mode"));
+}
+
+TEST(ValidationTest, ViewCount) {
+  v1::CreateSessionRequest none;
+  EXPECT_TRUE(invalid_naming(create(none), "views"));
+
+  v1::CreateSessionRequest duplicate;
+  *duplicate.add_views() = view(v1::VIEW_COCKPIT);
+  *duplicate.add_views() = view(v1::VIEW_ROAD);
+  *duplicate.add_views() = view(v1::VIEW_COCKPIT, 320, 180);
+  EXPECT_TRUE(invalid_naming(create(duplicate), "views[2].view"));
+
+  v1::CreateSessionRequest five;
+  for (v1::View v :
+       {v1::VIEW_COCKPIT, v1::VIEW_ROAD, v1::VIEW_WINDSHIELD, v1::VIEW_RAIN, v1::VIEW_COCKPIT}) {
+    *five.add_views() = view(v);
+  }
+  EXPECT_TRUE(invalid_naming(create(five), "views"));
+  five.mutable_views()->RemoveLast();
+  EXPECT_TRUE(create(five).ok());
+}
+
+TEST(ValidationTest, FpsAboveTheLimit) {
+  for (double bad : {Limits{}.max_fps + 1.0, -5.0, kNaN, kInf}) {
+    v1::CreateSessionRequest r = good_request();
+    r.set_fps(bad);
+    EXPECT_TRUE(invalid_naming(create(r), "fps")) << bad;
+  }
+}
+
+TEST(ValidationTest, StepDtMustBePositiveAndFinite) {
+  const Limits limits;
+  for (double bad : {0.0, -1.0, kNaN, kInf, limits.max_dt_s + 0.5}) {
+    EXPECT_TRUE(invalid_naming(check_dt(bad, "dt_s", false, limits), "dt_s")) << bad;
+  }
+  EXPECT_TRUE(check_dt(1.0 / 30.0, "dt_s", false, limits).ok());
+  EXPECT_TRUE(check_dt(limits.max_dt_s, "dt_s", false, limits).ok());
+  // Drive allows 0 (update only), nothing below.
+  EXPECT_TRUE(check_dt(0.0, "dt_s", true, limits).ok());
+  EXPECT_TRUE(invalid_naming(check_dt(-1.0, "dt_s", true, limits), "dt_s"));
+  EXPECT_TRUE(invalid_naming(check_dt(kNaN, "dt_s", true, limits), "dt_s"));
+}
+
+TEST(ValidationTest, ManualWipers) {
+  v1::Update no_angles;
+  no_angles.mutable_wipers()->set_mode(v1::WIPER_MANUAL);
+  EXPECT_TRUE(invalid_naming(update(no_angles), "update.wipers.blade_angle_deg"));
+
+  v1::Update too_far;
+  too_far.mutable_wipers()->set_mode(v1::WIPER_MANUAL);
+  too_far.mutable_wipers()->add_blade_angle_deg(10.0);
+  too_far.mutable_wipers()->add_blade_angle_deg(200.0);
+  EXPECT_TRUE(invalid_naming(update(too_far), "update.wipers.blade_angle_deg[1]"));
+
+  v1::Update three;
+  three.mutable_wipers()->set_mode(v1::WIPER_MANUAL);
+  for (int i = 0; i < 3; ++i) three.mutable_wipers()->add_blade_angle_deg(10.0);
+  EXPECT_TRUE(invalid_naming(update(three), "update.wipers.blade_angle_deg"));
+
+  v1::Update good;
+  good.mutable_wipers()->set_mode(v1::WIPER_MANUAL);
+  good.mutable_wipers()->add_blade_angle_deg(45.0);
+  good.mutable_wipers()->add_blade_angle_deg(50.0);
+  sim::Update out;
+  ASSERT_TRUE(to_update(good, "update", Limits{}, &out).ok());
+  ASSERT_TRUE(out.wipers);
+  EXPECT_EQ(out.wipers->mode, sim::WiperMode::kManual);
+  EXPECT_EQ(out.wipers->blade_angle_deg, (std::vector<double>{45.0, 50.0}));
+}
+
+TEST(ValidationTest, TrafficOverTheLimit) {
+  v1::Update u;
+  for (int i = 0; i <= Limits{}.max_traffic; ++i) u.add_traffic()->set_id(i);
+  EXPECT_TRUE(invalid_naming(update(u), "update.traffic"));
+  u.mutable_traffic()->RemoveLast();
+  sim::Update out;
+  ASSERT_TRUE(to_update(u, "update", Limits{}, &out).ok());
+  ASSERT_TRUE(out.traffic);
+  EXPECT_EQ(out.traffic->size(), static_cast<std::size_t>(Limits{}.max_traffic));
+}
+
+TEST(ValidationTest, BadTrafficVehicleIsNamedByIndex) {
+  v1::Update u;
+  u.add_traffic();
+  u.add_traffic()->mutable_state()->mutable_velocity_mps()->set_x(kNaN);
+  EXPECT_TRUE(invalid_naming(update(u), "update.traffic[1].state.velocity_mps.x"));
+}
+
+TEST(ValidationTest, CameraPoseIsForTheRoadViewOnly) {
+  v1::CreateSessionRequest r = good_request();
+  r.mutable_views(0)->mutable_camera_position_m()->set_x(1.0);
+  EXPECT_TRUE(invalid_naming(create(r), "views[0].camera_position_m"));
+}
+
+TEST(ValidationTest, SessionId) {
+  EXPECT_TRUE(invalid_naming(check_session_id("", "session_id"), "session_id"));
+  EXPECT_TRUE(invalid_naming(check_session_id(std::string(65, 'a'), "session_id"), "session_id"));
+  EXPECT_TRUE(check_session_id("s1-0123abcd", "session_id").ok());
+}
+
+TEST(ValidationTest, DefaultsAreFilledIn) {
+  v1::CreateSessionRequest r = good_request();
+  r.set_seed(77);
+  session::SessionConfig config;
+  sim::Update initial;
+  ASSERT_TRUE(to_session_config(r, Limits{}, &config, &initial).ok());
+  EXPECT_EQ(config.mode, sim::Mode::kRealtime);  // MODE_UNSPECIFIED
+  EXPECT_EQ(config.fps, 30.0);                   // fps 0
+  EXPECT_EQ(config.seed, 77u);
+  ASSERT_EQ(config.views.size(), 1u);
+  EXPECT_EQ(config.views[0].view, sim::View::kCockpit);
+  EXPECT_EQ(config.views[0].width, 640);
+  EXPECT_EQ(config.views[0].height, 360);
+  EXPECT_EQ(config.views[0].jpeg_quality, 85);  // jpeg_quality 0
+  EXPECT_EQ(config.views[0].fov_deg, 0.0);
+  EXPECT_FALSE(config.views[0].camera);
+  // An empty initial update carries no channels.
+  EXPECT_FALSE(initial.vehicle);
+  EXPECT_FALSE(initial.wipers);
+  EXPECT_FALSE(initial.weather);
+  EXPECT_FALSE(initial.traffic);
+}
+
+TEST(ValidationTest, GoodInputsConvertToDomainValues) {
+  v1::CreateSessionRequest r;
+  *r.add_views() = view(v1::VIEW_WINDSHIELD, 320, 180);
+  v1::ViewSpec road = view(v1::VIEW_ROAD, 1280, 720);
+  road.set_jpeg_quality(70);
+  road.set_fov_deg(60.0);
+  road.mutable_camera_position_m()->set_x(-6.0);
+  road.mutable_camera_rotation()->set_pitch_deg(10.0);
+  *r.add_views() = road;
+  r.set_mode(v1::MODE_LOCKSTEP);
+  r.set_fps(60.0);
+  v1::Update* u = r.mutable_initial();
+  u->set_sim_time_s(3.5);
+  v1::VehicleState* v = u->mutable_vehicle();
+  v->mutable_position_m()->set_x(100.0);
+  v->mutable_position_m()->set_y(-20.0);
+  v->mutable_rotation()->set_yaw_deg(90.0);
+  v->mutable_velocity_mps()->set_x(25.0);
+  u->mutable_wipers()->set_mode(v1::WIPER_INTERMITTENT);
+  u->mutable_wipers()->set_interval_s(6.0);
+  u->mutable_weather()->set_rain_rate_mm_h(25.0);
+  u->mutable_weather()->set_cloudiness(0.9);
+  u->mutable_weather()->set_rain_streak_count(1000);
+  v1::TrafficVehicle* t = u->add_traffic();
+  t->set_id(9);
+  t->mutable_state()->mutable_position_m()->set_x(130.0);
+
+  session::SessionConfig config;
+  sim::Update initial;
+  const grpc::Status status = to_session_config(r, Limits{}, &config, &initial);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(config.mode, sim::Mode::kLockstep);
+  EXPECT_EQ(config.fps, 60.0);
+  ASSERT_EQ(config.views.size(), 2u);
+  EXPECT_EQ(config.views[0].view, sim::View::kWindshield);
+  EXPECT_EQ(config.views[1].view, sim::View::kRoad);
+  EXPECT_EQ(config.views[1].width, 1280);
+  EXPECT_EQ(config.views[1].jpeg_quality, 70);
+  EXPECT_EQ(config.views[1].fov_deg, 60.0);
+  ASSERT_TRUE(config.views[1].camera);
+  EXPECT_EQ(config.views[1].camera->position_m, glm::dvec3(-6.0, 0.0, 0.0));
+  EXPECT_EQ(config.views[1].camera->rotation.pitch_deg, 10.0);
+
+  EXPECT_EQ(initial.client_time_s, 3.5);
+  ASSERT_TRUE(initial.vehicle);
+  EXPECT_EQ(initial.vehicle->position_m, glm::dvec3(100.0, -20.0, 0.0));
+  EXPECT_EQ(initial.vehicle->rotation.yaw_deg, 90.0);
+  EXPECT_EQ(initial.vehicle->velocity_mps, glm::dvec3(25.0, 0.0, 0.0));
+  ASSERT_TRUE(initial.wipers);
+  EXPECT_EQ(initial.wipers->mode, sim::WiperMode::kIntermittent);
+  EXPECT_EQ(initial.wipers->interval_s, 6.0);
+  ASSERT_TRUE(initial.weather);
+  EXPECT_EQ(initial.weather->rain_rate_mm_h, 25.0);
+  EXPECT_EQ(initial.weather->cloudiness, 0.9);
+  EXPECT_EQ(initial.weather->rain_streak_count, 1000u);
+  ASSERT_TRUE(initial.traffic);
+  ASSERT_EQ(initial.traffic->size(), 1u);
+  EXPECT_EQ((*initial.traffic)[0].id, 9u);
+  EXPECT_EQ((*initial.traffic)[0].state.position_m.x, 130.0);
+  EXPECT_EQ((*initial.traffic)[0].size_m, glm::dvec3(4.5, 1.8, 1.5));  // zero size = a car
+}
+
+TEST(ValidationTest, WiperIntervalDefaultsAndRange) {
+  v1::Update u;
+  u.mutable_wipers()->set_mode(v1::WIPER_INTERMITTENT);
+  sim::Update out;
+  ASSERT_TRUE(to_update(u, "update", Limits{}, &out).ok());
+  EXPECT_EQ(out.wipers->interval_s, 4.0);
+  u.mutable_wipers()->set_interval_s(kNaN);
+  EXPECT_TRUE(invalid_naming(update(u), "update.wipers.interval_s"));
+  u.mutable_wipers()->set_interval_s(120.0);
+  EXPECT_TRUE(invalid_naming(update(u), "update.wipers.interval_s"));
+}
+
+TEST(ValidationTest, ReplaceTrafficWithAnEmptyListClearsIt) {
+  v1::Update u;
+  sim::Update out;
+  ASSERT_TRUE(to_update(u, "update", Limits{}, &out).ok());
+  EXPECT_FALSE(out.traffic);  // absent: keep the list
+  u.set_replace_traffic(true);
+  ASSERT_TRUE(to_update(u, "update", Limits{}, &out).ok());
+  ASSERT_TRUE(out.traffic);
+  EXPECT_TRUE(out.traffic->empty());
+}
+
+}  // namespace
+}  // namespace downpour::rpc
