@@ -14,7 +14,8 @@
 int main(int argc, char** argv) {
   using namespace downpour;
   if (argc < 2) {
-    std::fprintf(stderr, "usage: downpour-render-views OUT_DIR [scene] [t_s] [width height] [rain_mm_h]\n");
+    std::fprintf(stderr,
+                 "usage: downpour-render-views OUT_DIR [scene] [t_s] [width height] [rain_mm_h]\n");
     return 2;
   }
   const std::string out = argv[1];
@@ -22,7 +23,8 @@ int main(int argc, char** argv) {
   const double t = argc > 3 ? std::atof(argv[3]) : 10.0;
   const int width = argc > 5 ? std::atoi(argv[4]) : 640;
   const int height = argc > 5 ? std::atoi(argv[5]) : 360;
-  const sim::Scenario scenario = scene_name == "city_drizzle" ? sim::city_drizzle() : sim::highway_heavy_rain();
+  const sim::Scenario scenario =
+      scene_name == "city_drizzle" ? sim::city_drizzle() : sim::highway_heavy_rain();
   sim::Update update = scenario.at(t);
   if (argc > 6 && update.weather) update.weather->rain_rate_mm_h = std::atof(argv[6]);
 
@@ -34,14 +36,18 @@ int main(int argc, char** argv) {
   renderer->set_profiling(true);
   sim::Simulation simulation(scenario.seed, update);
   simulation.advance(t);
-  for (sim::View view : {sim::View::kCockpit, sim::View::kRoad, sim::View::kWindshield, sim::View::kRain}) {
+  for (sim::View view :
+       {sim::View::kCockpit, sim::View::kRoad, sim::View::kWindshield, sim::View::kRain}) {
     sim::ViewSpec spec{view, width, height, 85, 0.0, std::nullopt};
-    render::render_image(*renderer, spec, simulation.state());  // the first draw compiles shader variants
-    testing::RgbaImage image{width, height, render::render_image(*renderer, spec, simulation.state())};
+    render::render_image(*renderer, spec,
+                         simulation.state());  // the first draw compiles shader variants
+    testing::RgbaImage image{width, height,
+                             render::render_image(*renderer, spec, simulation.state())};
     std::string path = out + "/" + std::string(sim::view_name(view)) + ".png";
     testing::write_png(path, image);
     std::printf("%s:", path.c_str());
-    for (const auto& pass : renderer->last_pass_timings()) std::printf(" %s %.2f ms", pass.name.c_str(), pass.ms);
+    for (const auto& pass : renderer->last_pass_timings())
+      std::printf(" %s %.2f ms", pass.name.c_str(), pass.ms);
     std::printf("\n");
   }
   return 0;

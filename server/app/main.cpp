@@ -22,7 +22,8 @@ int main(int argc, char** argv) {
   const auto config = app::parse_config(argc, argv, &exit_code);
   if (!config) return exit_code;
   spdlog::set_level(spdlog::level::from_str(config->log_level));
-  if (config->render_threads > 0) setenv("LP_NUM_THREADS", std::to_string(config->render_threads).c_str(), 1);
+  if (config->render_threads > 0)
+    setenv("LP_NUM_THREADS", std::to_string(config->render_threads).c_str(), 1);
 
   // Signals go to sigwait below, not to whichever thread happens to run.
   sigset_t signals;
@@ -68,26 +69,33 @@ int main(int argc, char** argv) {
   }
   // The GL context exists and a first frame rendered (scheduler.start): report SERVING.
   server->GetHealthCheckService()->SetServingStatus(true);
-  spdlog::info("listening on {} (port {}), up to {} sessions", config->listen, port, config->max_sessions);
+  spdlog::info("listening on {} (port {}), up to {} sessions", config->listen, port,
+               config->max_sessions);
   if (!config->port_file.empty()) {
     const std::string tmp = config->port_file + ".tmp";
     std::ofstream(tmp) << port << "\n";
     std::rename(tmp.c_str(), config->port_file.c_str());
   }
 
-  timespec wait{static_cast<time_t>(config->stats_interval_s),
-                static_cast<long>((config->stats_interval_s - static_cast<time_t>(config->stats_interval_s)) * 1e9)};
+  timespec wait{
+      static_cast<time_t>(config->stats_interval_s),
+      static_cast<long>((config->stats_interval_s - static_cast<time_t>(config->stats_interval_s)) *
+                        1e9)};
   int signal_number = 0;
   for (;;) {
     signal_number = sigtimedwait(&signals, nullptr, &wait);
     if (signal_number > 0) break;
     const session::SchedulerStats s = scheduler.stats();
-    spdlog::info("stats: {} sessions, {} frames rendered, {} encoded, render {:.2f} ms, encode {:.2f} ms (medians)",
-                 registry.list().size(), s.frames_rendered, s.frames_encoded, s.render_ms_median, s.encode_ms_median);
+    spdlog::info(
+        "stats: {} sessions, {} frames rendered, {} encoded, render {:.2f} ms, encode {:.2f} ms "
+        "(medians)",
+        registry.list().size(), s.frames_rendered, s.frames_encoded, s.render_ms_median,
+        s.encode_ms_median);
   }
   spdlog::info("signal {}: draining", signal_number);
   server->GetHealthCheckService()->SetServingStatus(false);
-  registry.close_all();  // ends streams and fails queued steps, so that shutdown does not wait on them
+  registry
+      .close_all();  // ends streams and fails queued steps, so that shutdown does not wait on them
   server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(5));
   scheduler.stop();
   spdlog::info("stopped");

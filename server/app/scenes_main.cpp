@@ -10,7 +10,8 @@ int main(int argc, char** argv) {
     std::cerr << "usage: downpour-scenes OUTPUT_DIR\n";
     return 2;
   }
-  for (const auto& scenario : {downpour::sim::highway_heavy_rain(), downpour::sim::city_drizzle()}) {
+  for (const auto& scenario :
+       {downpour::sim::highway_heavy_rain(), downpour::sim::city_drizzle()}) {
     const std::string path = std::string(argv[1]) + "/" + scenario.name + ".json";
     std::ofstream out(path);
     out << scenario.to_json();

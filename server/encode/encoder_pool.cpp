@@ -43,7 +43,9 @@ void EncoderPool::submit(EncodeJob job) {
   has_work_.notify_one();
 }
 
-void EncoderPool::set_on_idle_slot(std::function<void()> callback) { on_idle_slot_ = std::move(callback); }
+void EncoderPool::set_on_idle_slot(std::function<void()> callback) {
+  on_idle_slot_ = std::move(callback);
+}
 
 std::vector<std::uint8_t> EncoderPool::take_buffer(std::size_t bytes) {
   std::lock_guard lock(mutex_);
@@ -76,7 +78,8 @@ void EncoderPool::run() {
     } catch (const std::exception&) {
       jpeg.clear();  // the job's owner reports the failure
     }
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     job.done(std::move(jpeg), ms);
     {
       std::lock_guard lock(mutex_);

@@ -1,5 +1,6 @@
 // Encoder workers: JPEG-encode finished pixels off the render thread, so that rendering frame N+1
-// overlaps encoding frame N. The queue is bounded; the render thread reserves room before it renders.
+// overlaps encoding frame N. The queue is bounded; the render thread reserves room before it
+// renders.
 #pragma once
 
 #include <condition_variable>
@@ -48,11 +49,11 @@ class EncoderPool {
   const int max_queued_;
   std::mutex mutex_;
   std::condition_variable has_work_;
-  std::deque<EncodeJob> queue_;               // guarded by mutex_
-  int reserved_ = 0;                          // guarded by mutex_: reserved + queued + running
-  bool stopping_ = false;                     // guarded by mutex_
+  std::deque<EncodeJob> queue_;  // guarded by mutex_
+  int reserved_ = 0;             // guarded by mutex_: reserved + queued + running
+  bool stopping_ = false;        // guarded by mutex_
   std::vector<std::vector<std::uint8_t>> spare_buffers_;  // guarded by mutex_
-  std::function<void()> on_idle_slot_;        // set before jobs run
+  std::function<void()> on_idle_slot_;                    // set before jobs run
   std::vector<std::thread> workers_;
 };
 

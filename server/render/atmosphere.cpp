@@ -13,7 +13,8 @@ Atmosphere atmosphere_from(const sim::Weather& w) {
   Atmosphere a;
   const float alt = glm::radians(static_cast<float>(w.sun_altitude_deg));
   const float az = glm::radians(static_cast<float>(w.sun_azimuth_deg));
-  a.sun_direction = glm::vec3(std::cos(alt) * std::cos(az), std::cos(alt) * std::sin(az), std::sin(alt));
+  a.sun_direction =
+      glm::vec3(std::cos(alt) * std::cos(az), std::cos(alt) * std::sin(az), std::sin(alt));
 
   const float rain = static_cast<float>(w.rain_rate_mm_h);
   // Rain needs cloud: even light rain greys the sky; heavy rain darkens it further.
@@ -33,7 +34,9 @@ Atmosphere atmosphere_from(const sim::Weather& w) {
   const float low_sun = glm::smoothstep(25.0f, 0.0f, static_cast<float>(w.sun_altitude_deg)) * day;
   const glm::vec3 warm(1.0f, 0.72f, 0.5f);
   a.sky_zenith = glm::mix(clear_zenith, grey_zenith, a.overcast) * level;
-  a.sky_horizon = glm::mix(glm::mix(clear_horizon, clear_horizon * warm, low_sun), grey_horizon, a.overcast) * level;
+  a.sky_horizon =
+      glm::mix(glm::mix(clear_horizon, clear_horizon * warm, low_sun), grey_horizon, a.overcast) *
+      level;
 
   const float sun_up = std::max(std::sin(alt), 0.0f);
   const float direct = day * (1.0f - 0.9f * a.overcast) * rain_darkening;

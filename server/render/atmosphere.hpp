@@ -10,14 +10,14 @@ namespace downpour::render {
 
 struct Atmosphere {
   glm::vec3 sun_direction{0.0f, 0.0f, 1.0f};  // world, unit, towards the sun
-  glm::vec3 sun_radiance{1.0f};                // direct light reaching the ground
+  glm::vec3 sun_radiance{1.0f};               // direct light reaching the ground
   glm::vec3 sky_zenith{0.3f, 0.5f, 0.9f};
   glm::vec3 sky_horizon{0.7f, 0.8f, 0.95f};
-  glm::vec3 ambient{0.3f};                     // light from the whole sky on an upward surface
+  glm::vec3 ambient{0.3f};  // light from the whole sky on an upward surface
   glm::vec3 fog_colour{0.7f};
-  float fog_density = 0.0f;                    // extinction per metre
-  float overcast = 0.0f;                       // 0 clear .. 1 fully grey
-  float wetness = 0.0f;                        // 0 dry .. 1 soaked, a stand-in until the road water grid
+  float fog_density = 0.0f;  // extinction per metre
+  float overcast = 0.0f;     // 0 clear .. 1 fully grey
+  float wetness = 0.0f;      // 0 dry .. 1 soaked, a stand-in until the road water grid
 };
 
 Atmosphere atmosphere_from(const sim::Weather& weather);

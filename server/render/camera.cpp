@@ -11,8 +11,10 @@ namespace downpour::render {
 
 sim::CameraPose default_camera_pose(sim::View view) {
   switch (view) {
-    case sim::View::kRoad: return {{-6.5, 0.0, 2.6}, {0.0, 11.0, 0.0}};
-    default: return {kDriverEye, {0.0, 2.0, 0.0}};
+    case sim::View::kRoad:
+      return {{-6.5, 0.0, 2.6}, {0.0, 11.0, 0.0}};
+    default:
+      return {kDriverEye, {0.0, 2.0, 0.0}};
   }
 }
 

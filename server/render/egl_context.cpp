@@ -28,9 +28,10 @@ EGLDisplay open_gpu_device_display() {
       !has_extension(client_ext, "EGL_EXT_platform_device")) {
     return EGL_NO_DISPLAY;
   }
-  auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
-  auto query_device_string =
-      reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
+  auto query_devices =
+      reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+  auto query_device_string = reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(
+      eglGetProcAddress("eglQueryDeviceStringEXT"));
   if (!query_devices || !query_device_string) return EGL_NO_DISPLAY;
   EGLint count = 0;
   if (!query_devices(0, nullptr, &count) || count <= 0) return EGL_NO_DISPLAY;
@@ -49,7 +50,8 @@ EGLDisplay open_gpu_device_display() {
 }
 
 EGLDisplay open_surfaceless_display() {
-  EGLDisplay display = eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+  EGLDisplay display =
+      eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
   if (display == EGL_NO_DISPLAY) return EGL_NO_DISPLAY;
   EGLint major = 0, minor = 0;
   return eglInitialize(display, &major, &minor) ? display : EGL_NO_DISPLAY;
@@ -71,21 +73,37 @@ std::unique_ptr<EglContext> EglContext::create(EglPlatformChoice choice) {
     display = open_surfaceless_display();
     ctx->platform_ = "surfaceless";
   }
-  if (display == EGL_NO_DISPLAY) throw std::runtime_error("no EGL display: neither a GPU device nor Mesa surfaceless");
+  if (display == EGL_NO_DISPLAY)
+    throw std::runtime_error("no EGL display: neither a GPU device nor Mesa surfaceless");
   ctx->display_ = display;
 
   if (!eglBindAPI(EGL_OPENGL_API)) throw std::runtime_error("eglBindAPI(EGL_OPENGL_API) failed");
-  const EGLint config_attribs[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
-                                   EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8, EGL_NONE};
+  const EGLint config_attribs[] = {EGL_SURFACE_TYPE,
+                                   EGL_PBUFFER_BIT,
+                                   EGL_RENDERABLE_TYPE,
+                                   EGL_OPENGL_BIT,
+                                   EGL_RED_SIZE,
+                                   8,
+                                   EGL_GREEN_SIZE,
+                                   8,
+                                   EGL_BLUE_SIZE,
+                                   8,
+                                   EGL_NONE};
   EGLConfig config = nullptr;
   EGLint num_configs = 0;
   // Surfaceless contexts need no config; take one when offered, else go without.
-  if (!eglChooseConfig(display, config_attribs, &config, 1, &num_configs) || num_configs == 0) config = nullptr;
-  const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                                    EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+  if (!eglChooseConfig(display, config_attribs, &config, 1, &num_configs) || num_configs == 0)
+    config = nullptr;
+  const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                    4,
+                                    EGL_CONTEXT_MINOR_VERSION,
+                                    5,
+                                    EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                    EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
                                     EGL_NONE};
   EGLContext context = eglCreateContext(display, config, EGL_NO_CONTEXT, context_attribs);
-  if (context == EGL_NO_CONTEXT) throw std::runtime_error("eglCreateContext (OpenGL 4.5 core) failed");
+  if (context == EGL_NO_CONTEXT)
+    throw std::runtime_error("eglCreateContext (OpenGL 4.5 core) failed");
   ctx->context_ = context;
   if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context)) {
     throw std::runtime_error("eglMakeCurrent without a surface failed");

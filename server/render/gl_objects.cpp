@@ -25,7 +25,8 @@ std::string shader_source(const std::string& file, int depth = 0) {
     const std::string directive = "#include \"";
     if (line.rfind(directive, 0) == 0) {
       const auto end = line.find('"', directive.size());
-      out << shader_source(line.substr(directive.size(), end - directive.size()), depth + 1) << "\n";
+      out << shader_source(line.substr(directive.size(), end - directive.size()), depth + 1)
+          << "\n";
     } else {
       out << line << "\n";
     }
@@ -99,7 +100,9 @@ void ShaderProgram::set(const char* name, const glm::mat4& m) {
 }
 
 Mesh::Mesh(const MeshData& data)
-    : bounds_min(data.bounds_min), bounds_max(data.bounds_max), index_count_(static_cast<GLsizei>(data.indices.size())) {
+    : bounds_min(data.bounds_min),
+      bounds_max(data.bounds_max),
+      index_count_(static_cast<GLsizei>(data.indices.size())) {
   const auto& vertices = data.vertices;
   const auto& indices = data.indices;
   GLuint ids[2];
@@ -113,7 +116,8 @@ Mesh::Mesh(const MeshData& data)
   vao_ = VertexArray(vao);
   glVertexArrayVertexBuffer(vao, 0, vbo_.id(), 0, sizeof(MeshVertex));
   glVertexArrayElementBuffer(vao, ibo_.id());
-  const GLuint offsets[] = {offsetof(MeshVertex, position), offsetof(MeshVertex, normal), offsetof(MeshVertex, uv)};
+  const GLuint offsets[] = {offsetof(MeshVertex, position), offsetof(MeshVertex, normal),
+                            offsetof(MeshVertex, uv)};
   const GLint sizes[] = {3, 3, 2};
   for (GLuint a = 0; a < 3; ++a) {
     glEnableVertexArrayAttrib(vao, a);

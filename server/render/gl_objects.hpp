@@ -23,7 +23,9 @@ class GlName {
  public:
   GlName() = default;
   explicit GlName(GLuint id) : id_(id) {}
-  ~GlName() { if (id_) Delete(id_); }
+  ~GlName() {
+    if (id_) Delete(id_);
+  }
   GlName(GlName&& o) noexcept : id_(o.id_) { o.id_ = 0; }
   GlName& operator=(GlName&& o) noexcept {
     if (this != &o) {
@@ -64,9 +66,15 @@ class ShaderProgram {
 
   void set(const char* name, float v) { glProgramUniform1f(program_.id(), location(name), v); }
   void set(const char* name, int v) { glProgramUniform1i(program_.id(), location(name), v); }
-  void set(const char* name, glm::vec2 v) { glProgramUniform2f(program_.id(), location(name), v.x, v.y); }
-  void set(const char* name, glm::vec3 v) { glProgramUniform3f(program_.id(), location(name), v.x, v.y, v.z); }
-  void set(const char* name, glm::vec4 v) { glProgramUniform4f(program_.id(), location(name), v.x, v.y, v.z, v.w); }
+  void set(const char* name, glm::vec2 v) {
+    glProgramUniform2f(program_.id(), location(name), v.x, v.y);
+  }
+  void set(const char* name, glm::vec3 v) {
+    glProgramUniform3f(program_.id(), location(name), v.x, v.y, v.z);
+  }
+  void set(const char* name, glm::vec4 v) {
+    glProgramUniform4f(program_.id(), location(name), v.x, v.y, v.z, v.w);
+  }
   void set(const char* name, const glm::mat4& m);
 
  private:

@@ -12,8 +12,8 @@ std::uint32_t MeshData::add_vertex(const glm::vec3& p, const glm::vec3& n, const
   return static_cast<std::uint32_t>(vertices.size() - 1);
 }
 
-void MeshData::add_face(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& d,
-                        float material) {
+void MeshData::add_face(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
+                        const glm::vec3& d, float material) {
   const glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
   const glm::vec2 uv(material, 0.0f);
   add_quad(add_vertex(a, n, uv), add_vertex(b, n, uv), add_vertex(c, n, uv), add_vertex(d, n, uv));
@@ -26,9 +26,10 @@ void MeshData::add_box(const glm::vec3& lo, const glm::vec3& hi, float material)
 void MeshData::add_frustum(const glm::vec3& lo, const glm::vec3& hi, const glm::vec2& top_lo,
                            const glm::vec2& top_hi, float material) {
   // Bottom corners b0..b3 and top corners t0..t3, counter-clockwise seen from above.
-  const glm::vec3 b0(lo.x, lo.y, lo.z), b1(hi.x, lo.y, lo.z), b2(hi.x, hi.y, lo.z), b3(lo.x, hi.y, lo.z);
-  const glm::vec3 t0(top_lo.x, top_lo.y, hi.z), t1(top_hi.x, top_lo.y, hi.z), t2(top_hi.x, top_hi.y, hi.z),
-      t3(top_lo.x, top_hi.y, hi.z);
+  const glm::vec3 b0(lo.x, lo.y, lo.z), b1(hi.x, lo.y, lo.z), b2(hi.x, hi.y, lo.z),
+      b3(lo.x, hi.y, lo.z);
+  const glm::vec3 t0(top_lo.x, top_lo.y, hi.z), t1(top_hi.x, top_lo.y, hi.z),
+      t2(top_hi.x, top_hi.y, hi.z), t3(top_lo.x, top_hi.y, hi.z);
   add_face(t0, t1, t2, t3, material);  // top
   add_face(b0, b3, b2, b1, material);  // bottom
   add_face(b0, b1, t1, t0, material);  // right side (-y)

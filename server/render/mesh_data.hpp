@@ -22,20 +22,23 @@ struct MeshData {
   glm::vec3 bounds_max{-1e30f};
 
   std::uint32_t add_vertex(const glm::vec3& p, const glm::vec3& n, const glm::vec2& uv);
-  void add_triangle(std::uint32_t a, std::uint32_t b, std::uint32_t c) { indices.insert(indices.end(), {a, b, c}); }
+  void add_triangle(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    indices.insert(indices.end(), {a, b, c});
+  }
   void add_quad(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) {
     add_triangle(a, b, c);
     add_triangle(a, c, d);
   }
   // A flat-shaded convex quad face (corners counter-clockwise seen from outside); uv.x carries a
   // material id for the shader.
-  void add_face(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& d, float material);
+  void add_face(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& d,
+                float material);
   // An axis-aligned box.
   void add_box(const glm::vec3& lo, const glm::vec3& hi, float material);
   // A box whose top face is narrower/shorter: bottom rectangle lo..hi at z = lo.z, top rectangle
   // top_lo..top_hi (x, y) at z = hi.z.
-  void add_frustum(const glm::vec3& lo, const glm::vec3& hi, const glm::vec2& top_lo, const glm::vec2& top_hi,
-                   float material);
+  void add_frustum(const glm::vec3& lo, const glm::vec3& hi, const glm::vec2& top_lo,
+                   const glm::vec2& top_hi, float material);
 };
 
 }  // namespace downpour::render

@@ -15,12 +15,15 @@ std::vector<float> value_noise(int size, int cells, std::mt19937& rng) {
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   std::vector<float> lattice(static_cast<std::size_t>(cells * cells));
   for (float& v : lattice) v = u(rng);
-  auto at = [&](int i, int j) { return lattice[((j % cells + cells) % cells) * cells + ((i % cells + cells) % cells)]; };
+  auto at = [&](int i, int j) {
+    return lattice[((j % cells + cells) % cells) * cells + ((i % cells + cells) % cells)];
+  };
   auto fade = [](float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); };
   std::vector<float> out(static_cast<std::size_t>(size * size));
   for (int y = 0; y < size; ++y) {
     for (int x = 0; x < size; ++x) {
-      const float fx = static_cast<float>(x) * cells / size, fy = static_cast<float>(y) * cells / size;
+      const float fx = static_cast<float>(x) * cells / size,
+                  fy = static_cast<float>(y) * cells / size;
       const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
       const float tx = fade(fx - ix), ty = fade(fy - iy);
       const float a = at(ix, iy) + (at(ix + 1, iy) - at(ix, iy)) * tx;
@@ -31,7 +34,9 @@ std::vector<float> value_noise(int size, int cells, std::mt19937& rng) {
   return out;
 }
 
-std::uint8_t to_byte(float v) { return static_cast<std::uint8_t>(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f); }
+std::uint8_t to_byte(float v) {
+  return static_cast<std::uint8_t>(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f);
+}
 
 }  // namespace
 
@@ -66,8 +71,9 @@ Image8 make_asphalt_relief(int size, std::uint32_t seed, float relief_depth) {
   auto h = [&](int x, int y) { return height[((y + size) % size) * size + ((x + size) % size)]; };
   for (int y = 0; y < size; ++y) {
     for (int x = 0; x < size; ++x) {
-      const glm::vec3 n = glm::normalize(glm::vec3((h(x - 1, y) - h(x + 1, y)) * relief_depth,
-                                                   (h(x, y - 1) - h(x, y + 1)) * relief_depth, 2.0f));
+      const glm::vec3 n =
+          glm::normalize(glm::vec3((h(x - 1, y) - h(x + 1, y)) * relief_depth,
+                                   (h(x, y - 1) - h(x, y + 1)) * relief_depth, 2.0f));
       std::uint8_t* p = &img.rgba[static_cast<std::size_t>(y * size + x) * 4];
       p[0] = to_byte(n.x * 0.5f + 0.5f);
       p[1] = to_byte(n.y * 0.5f + 0.5f);

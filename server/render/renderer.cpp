@@ -43,7 +43,8 @@ Texture upload_repeating(const Image8& image, bool mipmaps) {
     for (int s = image.width; s > 1; s /= 2) ++levels;
   }
   Texture t = make_texture_2d(GL_RGBA8, image.width, image.height, levels);
-  glTextureSubImage2D(t.id(), 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
+  glTextureSubImage2D(t.id(), 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                      image.rgba.data());
   if (mipmaps) glGenerateTextureMipmap(t.id());
   glTextureParameteri(t.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
   glTextureParameteri(t.id(), GL_TEXTURE_WRAP_T, GL_REPEAT);
@@ -102,7 +103,9 @@ struct Renderer::Impl {
     const auto t0 = std::chrono::steady_clock::now();
     fn();
     if (profiling) glFinish();
-    timings.push_back({name, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count()});
+    timings.push_back(
+        {name,
+         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count()});
   }
 
   void upload_frame_block(const FrameContext& f) {
@@ -116,8 +119,8 @@ struct Renderer::Impl {
     b.sky_horizon = glm::vec4(f.atmosphere.sky_horizon, 0.0f);
     b.ambient = glm::vec4(f.atmosphere.ambient, 0.0f);
     b.fog = glm::vec4(f.atmosphere.fog_colour, f.atmosphere.fog_density);
-    b.params = glm::vec4(static_cast<float>(f.scene.sim_time_s), f.atmosphere.overcast, f.atmosphere.wetness,
-                         static_cast<float>(f.scene.weather.rain_rate_mm_h));
+    b.params = glm::vec4(static_cast<float>(f.scene.sim_time_s), f.atmosphere.overcast,
+                         f.atmosphere.wetness, static_cast<float>(f.scene.weather.rain_rate_mm_h));
     const float wind_dir = glm::radians(static_cast<float>(f.scene.weather.wind_direction_deg));
     b.wind = glm::vec4(std::cos(wind_dir), std::sin(wind_dir), 0.0f, 0.0f) *
              static_cast<float>(f.scene.weather.wind_speed_mps);
@@ -160,9 +163,9 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   glClearDepthf(0.0f);
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
 
-  impl->shared = std::make_unique<SharedResources>(SharedResources{
-      sim::Track::test_track(), upload_repeating(make_noise(256, 1), true),
-      upload_repeating(make_asphalt_relief(512, 2), true), FullscreenTriangle()});
+  impl->shared = std::make_unique<SharedResources>(
+      SharedResources{sim::Track::test_track(), upload_repeating(make_noise(256, 1), true),
+                      upload_repeating(make_asphalt_relief(512, 2), true), FullscreenTriangle()});
   glBindTextureUnit(binding::kNoise, impl->shared->noise.id());
   glBindTextureUnit(binding::kAsphalt, impl->shared->asphalt.id());
   GLuint ubo = 0;
@@ -187,19 +190,22 @@ const std::string& Renderer::platform() const { return impl_->context->platform(
 void Renderer::set_profiling(bool on) { impl_->profiling = on; }
 const std::vector<PassTiming>& Renderer::last_pass_timings() const { return impl_->timings; }
 
-PendingReadback Renderer::render(std::uint64_t key, const sim::ViewSpec& spec, const sim::SceneState& scene) {
+PendingReadback Renderer::render(std::uint64_t key, const sim::ViewSpec& spec,
+                                 const sim::SceneState& scene) {
   Impl& m = *impl_;
   m.timings.clear();
   auto& target = m.targets[key];
   if (!target || target->width != spec.width || target->height != spec.height) {
     for (int slot = 0; slot < kReadbackSlots; ++slot) {
-      if (m.in_flight.count({key, slot})) throw std::logic_error("render target resized with a readback in flight");
+      if (m.in_flight.count({key, slot}))
+        throw std::logic_error("render target resized with a readback in flight");
     }
     target = std::make_unique<ViewTarget>(spec.width, spec.height);
   }
   const int slot = target->next_slot;
   target->next_slot = (slot + 1) % kReadbackSlots;
-  if (m.in_flight.count({key, slot})) throw std::logic_error("readback slot reused before finish()");
+  if (m.in_flight.count({key, slot}))
+    throw std::logic_error("readback slot reused before finish()");
 
   FrameContext frame{scene, spec, make_camera(spec, scene.vehicle), atmosphere_from(scene.weather),
                      glm::mat4(sim::vehicle_to_world(scene.vehicle))};
@@ -237,7 +243,8 @@ void Renderer::finish(const PendingReadback& pending, std::vector<std::uint8_t>&
   Impl& m = *impl_;
   const auto it = m.in_flight.find({pending.target_key, pending.slot});
   if (it == m.in_flight.end()) throw std::logic_error("finish() of a readback not in flight");
-  while (glClientWaitSync(it->second, GL_SYNC_FLUSH_COMMANDS_BIT, 1'000'000'000) == GL_TIMEOUT_EXPIRED) {
+  while (glClientWaitSync(it->second, GL_SYNC_FLUSH_COMMANDS_BIT, 1'000'000'000) ==
+         GL_TIMEOUT_EXPIRED) {
   }
   glDeleteSync(it->second);
   m.in_flight.erase(it);
@@ -257,7 +264,8 @@ void Renderer::release_targets(const std::function<bool(std::uint64_t)>& matches
   }
 }
 
-std::vector<std::uint8_t> render_image(Renderer& renderer, const sim::ViewSpec& spec, const sim::SceneState& scene) {
+std::vector<std::uint8_t> render_image(Renderer& renderer, const sim::ViewSpec& spec,
+                                       const sim::SceneState& scene) {
   constexpr std::uint64_t kImageTarget = ~std::uint64_t{0};
   const PendingReadback pending = renderer.render(kImageTarget, spec, scene);
   std::vector<std::uint8_t> bottom_up;

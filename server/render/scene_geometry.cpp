@@ -13,11 +13,11 @@ constexpr double kVerge = 4.0;         // metres of verge beyond the paved edge
 constexpr double kVergeDrop = 0.35;    // how far the verge falls below the pavement edge
 constexpr double kTerrainCell = 20.0;  // metres
 constexpr double kTerrainMargin = 1300.0;
-constexpr int kTerrainChunks = 8;      // per axis
+constexpr int kTerrainChunks = 8;  // per axis
 
 double hills(double x, double y) {
-  return 5.0 * std::sin(x / 170.0 + 1.3) * std::cos(y / 210.0 - 0.4) + 2.5 * std::sin((x + 0.6 * y) / 85.0) +
-         1.2 * std::cos((0.7 * x - y) / 41.0);
+  return 5.0 * std::sin(x / 170.0 + 1.3) * std::cos(y / 210.0 - 0.4) +
+         2.5 * std::sin((x + 0.6 * y) / 85.0) + 1.2 * std::cos((0.7 * x - y) / 41.0);
 }
 
 }  // namespace
@@ -25,10 +25,14 @@ double hills(double x, double y) {
 std::vector<MeshData> build_road_chunks(const sim::Track& track, double chunk_length_m) {
   const double half = track.paved_half_width();
   // Lateral stations of the cross-section, left positive.
-  const std::vector<double> stations = {-half - kVerge, -half, -track.cross_section().lanes_each_way *
-                                                                   track.cross_section().lane_width_m,
-                                        0.0, track.cross_section().lanes_each_way * track.cross_section().lane_width_m,
-                                        half, half + kVerge};
+  const std::vector<double> stations = {
+      -half - kVerge,
+      -half,
+      -track.cross_section().lanes_each_way * track.cross_section().lane_width_m,
+      0.0,
+      track.cross_section().lanes_each_way * track.cross_section().lane_width_m,
+      half,
+      half + kVerge};
   std::vector<MeshData> chunks;
   const double step = 2.0;
   const int rows_total = static_cast<int>(std::ceil(track.length() / step));
@@ -45,10 +49,11 @@ std::vector<MeshData> build_road_chunks(const sim::Track& track, double chunk_le
         if (std::abs(lat) > half) z -= kVergeDrop * (std::abs(lat) - half) / kVerge;
         const glm::dvec2 xy = glm::dvec2(f.position) + f.left * lat;
         // Normal from the cross-slope and the grade.
-        const double cross = std::abs(lat) < 1e-9 ? 0.0
-                             : (std::abs(lat) <= half ? track.cross_section().crown_slope
-                                                      : kVergeDrop / kVerge) *
-                                   (lat > 0 ? -1.0 : 1.0);
+        const double cross = std::abs(lat) < 1e-9
+                                 ? 0.0
+                                 : (std::abs(lat) <= half ? track.cross_section().crown_slope
+                                                          : kVergeDrop / kVerge) *
+                                       (lat > 0 ? -1.0 : 1.0);
         const glm::dvec3 forward(std::cos(f.heading_rad), std::sin(f.heading_rad), f.grade);
         const glm::dvec3 side(f.left.x, f.left.y, cross);
         const glm::dvec3 n = glm::normalize(glm::cross(forward, side));
@@ -75,10 +80,11 @@ double terrain_height(const sim::Track& track, double x, double y) {
   // Far from the track the ground rises to a ring of low mountains.
   const glm::dvec2 centre(450.0, 250.0);
   const double r = glm::length(glm::dvec2(x, y) - centre);
-  const double far_hills = 70.0 * glm::smoothstep(1000.0, 1800.0, r) * (0.7 + 0.3 * std::sin(x / 300.0 + y / 410.0));
+  const double far_hills =
+      70.0 * glm::smoothstep(1000.0, 1800.0, r) * (0.7 + 0.3 * std::sin(x / 300.0 + y / 410.0));
   const double natural = edge + hills(x, y) + far_hills;
   const double blend = glm::smoothstep(0.0, 60.0, d);
-  return glm::mix(std::min(edge, natural) , natural, blend);
+  return glm::mix(std::min(edge, natural), natural, blend);
 }
 
 std::vector<MeshData> build_terrain_chunks(const sim::Track& track) {
@@ -96,8 +102,8 @@ std::vector<MeshData> build_terrain_chunks(const sim::Track& track) {
   std::vector<float> heights(static_cast<std::size_t>((nx + 1) * (ny + 1)));
   for (int j = 0; j <= ny; ++j) {
     for (int i = 0; i <= nx; ++i) {
-      heights[j * (nx + 1) + i] =
-          static_cast<float>(terrain_height(track, lo.x + i * kTerrainCell, lo.y + j * kTerrainCell));
+      heights[j * (nx + 1) + i] = static_cast<float>(
+          terrain_height(track, lo.x + i * kTerrainCell, lo.y + j * kTerrainCell));
     }
   }
   auto h = [&](int i, int j) {
@@ -115,8 +121,9 @@ std::vector<MeshData> build_terrain_chunks(const sim::Track& track) {
         for (int i = i0; i <= i1; ++i) {
           const float x = static_cast<float>(lo.x + i * kTerrainCell);
           const float y = static_cast<float>(lo.y + j * kTerrainCell);
-          const glm::vec3 n = glm::normalize(glm::vec3(h(i - 1, j) - h(i + 1, j), h(i, j - 1) - h(i, j + 1),
-                                                       2.0f * static_cast<float>(kTerrainCell)));
+          const glm::vec3 n =
+              glm::normalize(glm::vec3(h(i - 1, j) - h(i + 1, j), h(i, j - 1) - h(i, j + 1),
+                                       2.0f * static_cast<float>(kTerrainCell)));
           m.add_vertex({x, y, h(i, j)}, n, {x, y});
         }
       }

@@ -7,14 +7,16 @@ namespace downpour::render {
 MeshData build_car_hull() {
   MeshData m;
   // Lower body from the rear bumper (x = -0.95) to the front bumper (x = 3.65).
-  m.add_frustum({-0.95f, -0.9f, 0.28f}, {3.65f, 0.9f, 0.92f}, {-0.9f, -0.88f}, {3.6f, 0.88f}, material::kBody);
+  m.add_frustum({-0.95f, -0.9f, 0.28f}, {3.65f, 0.9f, 0.92f}, {-0.9f, -0.88f}, {3.6f, 0.88f},
+                material::kBody);
   return m;
 }
 
 MeshData build_car_upper() {
   MeshData m;
   // Cabin: glass house narrowing towards the roof.
-  m.add_frustum({-0.55f, -0.82f, 0.92f}, {2.06f, 0.82f, 1.45f}, {-0.2f, -0.7f}, {1.4f, 0.7f}, material::kGlass);
+  m.add_frustum({-0.55f, -0.82f, 0.92f}, {2.06f, 0.82f, 1.45f}, {-0.2f, -0.7f}, {1.4f, 0.7f},
+                material::kGlass);
   m.add_box({-0.15f, -0.71f, 1.44f}, {1.35f, 0.71f, 1.47f}, material::kBody);  // roof panel
   // Wheels: radius 0.33 at the axles x = 0 and x = 2.7.
   for (float x : {0.0f, 2.7f}) {
@@ -32,15 +34,17 @@ MeshData build_cockpit_interior(const WindshieldCorners& g) {
   MeshData m;
   const float dash_back = 1.45f;
   // Dashboard top: from the glass's lower edge back towards the driver, slightly lower at the back.
-  m.add_face({dash_back, -0.85f, g.bottom_left.z - 0.03f}, {g.bottom_right.x, -0.85f, g.bottom_right.z - 0.005f},
-             {g.bottom_left.x, 0.85f, g.bottom_left.z - 0.005f}, {dash_back, 0.85f, g.bottom_left.z - 0.03f},
-             material::kTrim);
+  m.add_face({dash_back, -0.85f, g.bottom_left.z - 0.03f},
+             {g.bottom_right.x, -0.85f, g.bottom_right.z - 0.005f},
+             {g.bottom_left.x, 0.85f, g.bottom_left.z - 0.005f},
+             {dash_back, 0.85f, g.bottom_left.z - 0.03f}, material::kTrim);
   // Its face towards the driver.
-  m.add_face({dash_back, 0.85f, 0.55f}, {dash_back, -0.85f, 0.55f}, {dash_back, -0.85f, g.bottom_left.z - 0.03f},
+  m.add_face({dash_back, 0.85f, 0.55f}, {dash_back, -0.85f, 0.55f},
+             {dash_back, -0.85f, g.bottom_left.z - 0.03f},
              {dash_back, 0.85f, g.bottom_left.z - 0.03f}, material::kTrim);
   // Instrument hood in front of the driver.
-  m.add_frustum({dash_back - 0.02f, 0.17f, 0.9f}, {1.78f, 0.57f, 1.03f}, {dash_back, 0.2f}, {1.66f, 0.54f},
-                material::kTrim);
+  m.add_frustum({dash_back - 0.02f, 0.17f, 0.9f}, {1.78f, 0.57f, 1.03f}, {dash_back, 0.2f},
+                {1.66f, 0.54f}, material::kTrim);
   // A-pillars along the glass's side edges, 9 cm wide, 6 cm deep.
   for (int side : {-1, 1}) {
     const glm::vec3 lo = side > 0 ? g.bottom_left : g.bottom_right;
@@ -57,8 +61,9 @@ MeshData build_cockpit_interior(const WindshieldCorners& g) {
     }
   }
   // Roof liner from the glass's top edge back over the driver.
-  m.add_face({g.top_right.x + 0.02f, -0.9f, g.top_right.z}, {g.top_left.x + 0.02f, 0.9f, g.top_left.z},
-             {0.2f, 0.9f, g.top_left.z + 0.06f}, {0.2f, -0.9f, g.top_right.z + 0.06f}, material::kTrim);
+  m.add_face({g.top_right.x + 0.02f, -0.9f, g.top_right.z},
+             {g.top_left.x + 0.02f, 0.9f, g.top_left.z}, {0.2f, 0.9f, g.top_left.z + 0.06f},
+             {0.2f, -0.9f, g.top_right.z + 0.06f}, material::kTrim);
   // Rear-view mirror on a short stem.
   m.add_box({1.55f, -0.09f, 1.27f}, {1.57f, 0.09f, 1.32f}, material::kBody);
   m.add_box({1.5f, -0.012f, 1.32f}, {1.52f, 0.012f, 1.37f}, material::kTrim);

@@ -4,10 +4,14 @@ namespace downpour::rpc {
 
 v1::View to_proto(sim::View view) {
   switch (view) {
-    case sim::View::kCockpit: return v1::VIEW_COCKPIT;
-    case sim::View::kRoad: return v1::VIEW_ROAD;
-    case sim::View::kWindshield: return v1::VIEW_WINDSHIELD;
-    case sim::View::kRain: return v1::VIEW_RAIN;
+    case sim::View::kCockpit:
+      return v1::VIEW_COCKPIT;
+    case sim::View::kRoad:
+      return v1::VIEW_ROAD;
+    case sim::View::kWindshield:
+      return v1::VIEW_WINDSHIELD;
+    case sim::View::kRain:
+      return v1::VIEW_RAIN;
   }
   return v1::VIEW_UNSPECIFIED;
 }

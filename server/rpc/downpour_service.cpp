@@ -29,12 +29,15 @@ grpc::Status not_found(const std::string& id) {
 
 grpc::Status submit_status(Session::Submit result, const std::string& id) {
   switch (result) {
-    case Session::Submit::kQueued: return grpc::Status::OK;
+    case Session::Submit::kQueued:
+      return grpc::Status::OK;
     case Session::Submit::kFull:
       return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                          "session " + id + ": more than " + std::to_string(Session::kMaxQueuedJobs) +
+                          "session " + id + ": more than " +
+                              std::to_string(Session::kMaxQueuedJobs) +
                               " requests waiting; wait for frames before sending more");
-    case Session::Submit::kClosed: return not_found(id);
+    case Session::Submit::kClosed:
+      return not_found(id);
   }
   return grpc::Status(grpc::StatusCode::INTERNAL, "unexpected submit result");
 }
@@ -131,13 +134,15 @@ class DriveReactor final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
       if (!lockstep_) session->add_sink(shared_from_this());
       spdlog::debug("session {}: Drive stream attached", session->id());
     } else if (!req.session_id().empty() && req.session_id() != session->id()) {
-      return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                          "session_id: a Drive stream stays with its first session '" + session->id() + "'");
+      return grpc::Status(
+          grpc::StatusCode::INVALID_ARGUMENT,
+          "session_id: a Drive stream stays with its first session '" + session->id() + "'");
     }
     sim::Update update;
     if (auto s = to_update(req.update(), "update", ctx_.limits, &update); !s.ok()) return s;
     if (auto s = check_dt(req.dt_s(), "dt_s", true, ctx_.limits); !s.ok()) return s;
-    if (!lockstep_ || req.dt_s() == 0.0) return submit_status(session->post_update(update), session->id());
+    if (!lockstep_ || req.dt_s() == 0.0)
+      return submit_status(session->post_update(update), session->id());
 
     std::size_t index;
     {
@@ -146,17 +151,18 @@ class DriveReactor final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
       pending_.emplace_back();
     }
     auto self = shared_from_this();
-    const auto result = session->submit_step(std::move(update), req.dt_s(), [self, index](session::StepOutcome o) {
-      std::unique_lock lock(self->mutex_);
-      if (!o.ok) {
-        self->finish_with(lock, grpc::Status(grpc::StatusCode::ABORTED, o.error));
-        return;
-      }
-      v1::DriveResponse response;
-      for (const FramePtr& f : o.frames) fill_frame(*f, 0, response.add_frames());
-      self->pending_[index - self->first_index_] = std::move(response);
-      self->advance(lock);
-    });
+    const auto result =
+        session->submit_step(std::move(update), req.dt_s(), [self, index](session::StepOutcome o) {
+          std::unique_lock lock(self->mutex_);
+          if (!o.ok) {
+            self->finish_with(lock, grpc::Status(grpc::StatusCode::ABORTED, o.error));
+            return;
+          }
+          v1::DriveResponse response;
+          for (const FramePtr& f : o.frames) fill_frame(*f, 0, response.add_frames());
+          self->pending_[index - self->first_index_] = std::move(response);
+          self->advance(lock);
+        });
     return submit_status(result, session->id());
   }
 
@@ -209,18 +215,19 @@ class DriveReactor final : public grpc::ServerBidiReactor<v1::DriveRequest, v1::
   v1::DriveResponse out_;
   session::LatestFrameSlot slot_;
   std::mutex mutex_;
-  std::shared_ptr<Session> session_;                 // guarded by mutex_
-  bool lockstep_ = false;                            // set with session_
-  std::deque<std::optional<v1::DriveResponse>> pending_;  // guarded by mutex_: lockstep responses in order
-  std::size_t first_index_ = 0;                      // guarded by mutex_: index of pending_.front()
-  std::size_t next_index_ = 0;                       // guarded by mutex_
-  bool reading_ = true;                              // guarded by mutex_: a read is outstanding
-  bool writing_ = false;                             // guarded by mutex_
-  bool read_done_ = false;                           // guarded by mutex_
-  bool session_closed_ = false;                      // guarded by mutex_
-  bool finished_ = false;                            // guarded by mutex_
-  bool done_ = false;                                // guarded by mutex_
-  std::optional<grpc::Status> final_status_;         // guarded by mutex_
+  std::shared_ptr<Session> session_;  // guarded by mutex_
+  bool lockstep_ = false;             // set with session_
+  std::deque<std::optional<v1::DriveResponse>>
+      pending_;                               // guarded by mutex_: lockstep responses in order
+  std::size_t first_index_ = 0;               // guarded by mutex_: index of pending_.front()
+  std::size_t next_index_ = 0;                // guarded by mutex_
+  bool reading_ = true;                       // guarded by mutex_: a read is outstanding
+  bool writing_ = false;                      // guarded by mutex_
+  bool read_done_ = false;                    // guarded by mutex_
+  bool session_closed_ = false;               // guarded by mutex_
+  bool finished_ = false;                     // guarded by mutex_
+  bool done_ = false;                         // guarded by mutex_
+  std::optional<grpc::Status> final_status_;  // guarded by mutex_
 };
 
 // WatchFrames: the latest frames of the chosen views; one write in flight, a newer frame replaces
@@ -281,9 +288,12 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::Frame>,
   }
 
  private:
-  WatchReactor(DownpourService::Context& ctx, std::shared_ptr<Session> session, std::array<bool, sim::kViewCount> views,
-               double max_fps)
-      : ctx_(ctx), session_(std::move(session)), views_(views), min_interval_s_(max_fps > 0.0 ? 1.0 / max_fps : 0.0) {
+  WatchReactor(DownpourService::Context& ctx, std::shared_ptr<Session> session,
+               std::array<bool, sim::kViewCount> views, double max_fps)
+      : ctx_(ctx),
+        session_(std::move(session)),
+        views_(views),
+        min_interval_s_(max_fps > 0.0 ? 1.0 / max_fps : 0.0) {
     last_sent_time_.fill(-1.0);
   }
 
@@ -293,7 +303,8 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::Frame>,
     if (failed_ || session_closed_) {
       finished_ = true;
       lock.unlock();
-      Finish(failed_ ? grpc::Status(grpc::StatusCode::CANCELLED, "the reader went away") : grpc::Status::OK);
+      Finish(failed_ ? grpc::Status(grpc::StatusCode::CANCELLED, "the reader went away")
+                     : grpc::Status::OK);
       return;
     }
     FramePtr frame = slot_.take();
@@ -322,87 +333,105 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::Frame>,
 
 }  // namespace
 
-DownpourService::DownpourService(session::SessionRegistry& registry, session::FrameScheduler& scheduler, Limits limits)
-    : scheduler_(scheduler), context_{registry, limits}, started_(std::chrono::steady_clock::now()) {}
+DownpourService::DownpourService(session::SessionRegistry& registry,
+                                 session::FrameScheduler& scheduler, Limits limits)
+    : scheduler_(scheduler),
+      context_{registry, limits},
+      started_(std::chrono::steady_clock::now()) {}
 
 grpc::ServerUnaryReactor* DownpourService::CreateSession(grpc::CallbackServerContext* ctx,
                                                          const v1::CreateSessionRequest* request,
                                                          v1::SessionInfo* response) {
   session::SessionConfig config;
   sim::Update initial;
-  if (auto s = to_session_config(*request, context_.limits, &config, &initial); !s.ok()) return finish(ctx, s);
+  if (auto s = to_session_config(*request, context_.limits, &config, &initial); !s.ok())
+    return finish(ctx, s);
   auto session = context_.registry.create(std::move(config), initial);
   if (!session) {
     return finish(ctx, grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                                    "sessions: the server's limit of " + std::to_string(context_.registry.max_sessions()) +
+                                    "sessions: the server's limit of " +
+                                        std::to_string(context_.registry.max_sessions()) +
                                         " sessions is reached; close one first"));
   }
   fill_session_info(*session, response);
   spdlog::info("session {} started: {} mode, {} view(s), seed {}, peer {}", session->id(),
-               session->config().mode == sim::Mode::kLockstep ? "lockstep" : "realtime", session->config().views.size(),
-               session->config().seed, ctx->peer());
+               session->config().mode == sim::Mode::kLockstep ? "lockstep" : "realtime",
+               session->config().views.size(), session->config().seed, ctx->peer());
   return finish(ctx, grpc::Status::OK);
 }
 
 grpc::ServerUnaryReactor* DownpourService::CloseSession(grpc::CallbackServerContext* ctx,
                                                         const v1::CloseSessionRequest* request,
                                                         v1::CloseSessionResponse*) {
-  if (auto s = check_session_id(request->session_id(), "session_id"); !s.ok()) return finish(ctx, s);
+  if (auto s = check_session_id(request->session_id(), "session_id"); !s.ok())
+    return finish(ctx, s);
   const auto session = context_.registry.find(request->session_id());
-  if (!session || !context_.registry.close(request->session_id())) return finish(ctx, not_found(request->session_id()));
-  spdlog::info("session {} ended: {} frames, sim time {:.2f} s", session->id(), session->frames_rendered(),
-               session->sim_time_s());
+  if (!session || !context_.registry.close(request->session_id()))
+    return finish(ctx, not_found(request->session_id()));
+  spdlog::info("session {} ended: {} frames, sim time {:.2f} s", session->id(),
+               session->frames_rendered(), session->sim_time_s());
   return finish(ctx, grpc::Status::OK);
 }
 
-grpc::ServerUnaryReactor* DownpourService::ListSessions(grpc::CallbackServerContext* ctx, const v1::ListSessionsRequest*,
+grpc::ServerUnaryReactor* DownpourService::ListSessions(grpc::CallbackServerContext* ctx,
+                                                        const v1::ListSessionsRequest*,
                                                         v1::ListSessionsResponse* response) {
   for (const auto& s : context_.registry.list()) fill_session_info(*s, response->add_sessions());
   return finish(ctx, grpc::Status::OK);
 }
 
-grpc::ServerUnaryReactor* DownpourService::Update(grpc::CallbackServerContext* ctx, const v1::UpdateRequest* request,
+grpc::ServerUnaryReactor* DownpourService::Update(grpc::CallbackServerContext* ctx,
+                                                  const v1::UpdateRequest* request,
                                                   v1::UpdateResponse* response) {
-  if (auto s = check_session_id(request->session_id(), "session_id"); !s.ok()) return finish(ctx, s);
+  if (auto s = check_session_id(request->session_id(), "session_id"); !s.ok())
+    return finish(ctx, s);
   sim::Update update;
-  if (auto s = to_update(request->update(), "update", context_.limits, &update); !s.ok()) return finish(ctx, s);
+  if (auto s = to_update(request->update(), "update", context_.limits, &update); !s.ok())
+    return finish(ctx, s);
   const auto session = context_.registry.find(request->session_id());
   if (!session) return finish(ctx, not_found(request->session_id()));
   response->set_sim_time_s(session->sim_time_s());
   return finish(ctx, submit_status(session->post_update(update), session->id()));
 }
 
-grpc::ServerUnaryReactor* DownpourService::Step(grpc::CallbackServerContext* ctx, const v1::StepRequest* request,
+grpc::ServerUnaryReactor* DownpourService::Step(grpc::CallbackServerContext* ctx,
+                                                const v1::StepRequest* request,
                                                 v1::StepResponse* response) {
-  if (auto s = check_session_id(request->session_id(), "session_id"); !s.ok()) return finish(ctx, s);
+  if (auto s = check_session_id(request->session_id(), "session_id"); !s.ok())
+    return finish(ctx, s);
   sim::Update update;
-  if (auto s = to_update(request->update(), "update", context_.limits, &update); !s.ok()) return finish(ctx, s);
-  if (auto s = check_dt(request->dt_s(), "dt_s", false, context_.limits); !s.ok()) return finish(ctx, s);
+  if (auto s = to_update(request->update(), "update", context_.limits, &update); !s.ok())
+    return finish(ctx, s);
+  if (auto s = check_dt(request->dt_s(), "dt_s", false, context_.limits); !s.ok())
+    return finish(ctx, s);
   const auto session = context_.registry.find(request->session_id());
   if (!session) return finish(ctx, not_found(request->session_id()));
   if (session->config().mode != sim::Mode::kLockstep) {
     return finish(ctx, grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
-                                    "session " + session->id() + " is realtime; Step needs a MODE_LOCKSTEP session"));
+                                    "session " + session->id() +
+                                        " is realtime; Step needs a MODE_LOCKSTEP session"));
   }
   grpc::ServerUnaryReactor* reactor = ctx->DefaultReactor();
-  const auto result = session->submit_step(std::move(update), request->dt_s(), [reactor, response](session::StepOutcome o) {
-    if (!o.ok) {
-      reactor->Finish(grpc::Status(grpc::StatusCode::ABORTED, o.error));
-      return;
-    }
-    for (const FramePtr& f : o.frames) fill_frame(*f, 0, response->add_frames());
-    reactor->Finish(grpc::Status::OK);
-  });
+  const auto result = session->submit_step(
+      std::move(update), request->dt_s(), [reactor, response](session::StepOutcome o) {
+        if (!o.ok) {
+          reactor->Finish(grpc::Status(grpc::StatusCode::ABORTED, o.error));
+          return;
+        }
+        for (const FramePtr& f : o.frames) fill_frame(*f, 0, response->add_frames());
+        reactor->Finish(grpc::Status::OK);
+      });
   if (result != Session::Submit::kQueued) reactor->Finish(submit_status(result, session->id()));
   return reactor;
 }
 
-grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveResponse>* DownpourService::Drive(grpc::CallbackServerContext*) {
+grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveResponse>* DownpourService::Drive(
+    grpc::CallbackServerContext*) {
   return DriveReactor::start(context_);
 }
 
-grpc::ServerWriteReactor<v1::Frame>* DownpourService::WatchFrames(grpc::CallbackServerContext*,
-                                                                  const v1::WatchFramesRequest* request) {
+grpc::ServerWriteReactor<v1::Frame>* DownpourService::WatchFrames(
+    grpc::CallbackServerContext*, const v1::WatchFramesRequest* request) {
   auto fail = [](const grpc::Status& status) {
     struct Failed final : grpc::ServerWriteReactor<v1::Frame> {
       explicit Failed(const grpc::Status& s) { Finish(s); }
@@ -414,7 +443,8 @@ grpc::ServerWriteReactor<v1::Frame>* DownpourService::WatchFrames(grpc::Callback
   const auto session = context_.registry.find(request->session_id());
   if (!session) return fail(not_found(request->session_id()));
   std::array<bool, sim::kViewCount> wanted{};
-  for (const sim::ViewSpec& v : session->config().views) wanted[static_cast<int>(v.view)] = request->views_size() == 0;
+  for (const sim::ViewSpec& v : session->config().views)
+    wanted[static_cast<int>(v.view)] = request->views_size() == 0;
   for (int i = 0; i < request->views_size(); ++i) {
     const std::string field = "views[" + std::to_string(i) + "]";
     const int v = request->views(i);
@@ -426,17 +456,20 @@ grpc::ServerWriteReactor<v1::Frame>* DownpourService::WatchFrames(grpc::Callback
       }
     }
     if (!found) {
-      return fail(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                               field + ": view " + std::to_string(v) + " is not one of the session's views"));
+      return fail(grpc::Status(
+          grpc::StatusCode::INVALID_ARGUMENT,
+          field + ": view " + std::to_string(v) + " is not one of the session's views"));
     }
   }
-  if (!std::isfinite(request->max_fps()) || request->max_fps() < 0.0 || request->max_fps() > 1000.0) {
+  if (!std::isfinite(request->max_fps()) || request->max_fps() < 0.0 ||
+      request->max_fps() > 1000.0) {
     return fail(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "max_fps: must be in [0, 1000]"));
   }
   return WatchReactor::start(context_, session, wanted, request->max_fps());
 }
 
-grpc::ServerUnaryReactor* DownpourService::GetStats(grpc::CallbackServerContext* ctx, const v1::GetStatsRequest*,
+grpc::ServerUnaryReactor* DownpourService::GetStats(grpc::CallbackServerContext* ctx,
+                                                    const v1::GetStatsRequest*,
                                                     v1::ServerStats* response) {
   const session::SchedulerStats s = scheduler_.stats();
   response->set_renderer(s.renderer);
@@ -447,7 +480,8 @@ grpc::ServerUnaryReactor* DownpourService::GetStats(grpc::CallbackServerContext*
   response->set_render_ms_median(s.render_ms_median);
   response->set_encode_ms_median(s.encode_ms_median);
   response->set_encoder_threads(static_cast<std::uint32_t>(s.encoder_threads));
-  response->set_uptime_s(std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count());
+  response->set_uptime_s(
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count());
   return finish(ctx, grpc::Status::OK);
 }
 

@@ -13,22 +13,29 @@ namespace downpour::rpc {
 
 class DownpourService final : public v1::Downpour::CallbackService {
  public:
-  DownpourService(session::SessionRegistry& registry, session::FrameScheduler& scheduler, Limits limits);
+  DownpourService(session::SessionRegistry& registry, session::FrameScheduler& scheduler,
+                  Limits limits);
 
-  grpc::ServerUnaryReactor* CreateSession(grpc::CallbackServerContext* ctx, const v1::CreateSessionRequest* request,
+  grpc::ServerUnaryReactor* CreateSession(grpc::CallbackServerContext* ctx,
+                                          const v1::CreateSessionRequest* request,
                                           v1::SessionInfo* response) override;
-  grpc::ServerUnaryReactor* CloseSession(grpc::CallbackServerContext* ctx, const v1::CloseSessionRequest* request,
+  grpc::ServerUnaryReactor* CloseSession(grpc::CallbackServerContext* ctx,
+                                         const v1::CloseSessionRequest* request,
                                          v1::CloseSessionResponse* response) override;
-  grpc::ServerUnaryReactor* ListSessions(grpc::CallbackServerContext* ctx, const v1::ListSessionsRequest* request,
+  grpc::ServerUnaryReactor* ListSessions(grpc::CallbackServerContext* ctx,
+                                         const v1::ListSessionsRequest* request,
                                          v1::ListSessionsResponse* response) override;
-  grpc::ServerUnaryReactor* Update(grpc::CallbackServerContext* ctx, const v1::UpdateRequest* request,
+  grpc::ServerUnaryReactor* Update(grpc::CallbackServerContext* ctx,
+                                   const v1::UpdateRequest* request,
                                    v1::UpdateResponse* response) override;
   grpc::ServerUnaryReactor* Step(grpc::CallbackServerContext* ctx, const v1::StepRequest* request,
                                  v1::StepResponse* response) override;
-  grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveResponse>* Drive(grpc::CallbackServerContext* ctx) override;
+  grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveResponse>* Drive(
+      grpc::CallbackServerContext* ctx) override;
   grpc::ServerWriteReactor<v1::Frame>* WatchFrames(grpc::CallbackServerContext* ctx,
                                                    const v1::WatchFramesRequest* request) override;
-  grpc::ServerUnaryReactor* GetStats(grpc::CallbackServerContext* ctx, const v1::GetStatsRequest* request,
+  grpc::ServerUnaryReactor* GetStats(grpc::CallbackServerContext* ctx,
+                                     const v1::GetStatsRequest* request,
                                      v1::ServerStats* response) override;
 
   // Everything the stream reactors need from the service.

@@ -20,15 +20,16 @@ grpc::Status invalid(const std::string& field, const std::string& what) {
 grpc::Status in_range(double v, double lo, double hi, const std::string& field) {
   if (!std::isfinite(v)) return invalid(field, "must be a finite number, got " + number_text(v));
   if (v < lo || v > hi) {
-    return invalid(field, "must be in [" + number_text(lo) + ", " + number_text(hi) + "], got " + number_text(v));
+    return invalid(field, "must be in [" + number_text(lo) + ", " + number_text(hi) + "], got " +
+                              number_text(v));
   }
   return grpc::Status::OK;
 }
 
-#define DP_RETURN_IF_ERROR(expr)          \
-  do {                                    \
-    const grpc::Status status_ = (expr);  \
-    if (!status_.ok()) return status_;    \
+#define DP_RETURN_IF_ERROR(expr)         \
+  do {                                   \
+    const grpc::Status status_ = (expr); \
+    if (!status_.ok()) return status_;   \
   } while (0)
 
 grpc::Status to_vec3(const v1::Vec3& in, double limit, const std::string& field, glm::dvec3* out) {
@@ -47,38 +48,56 @@ grpc::Status to_rotation(const v1::Rotation& in, const std::string& field, sim::
   return grpc::Status::OK;
 }
 
-grpc::Status to_vehicle(const v1::VehicleState& in, const std::string& field, sim::VehicleState* out) {
+grpc::Status to_vehicle(const v1::VehicleState& in, const std::string& field,
+                        sim::VehicleState* out) {
   DP_RETURN_IF_ERROR(to_vec3(in.position_m(), 1e6, field + ".position_m", &out->position_m));
   DP_RETURN_IF_ERROR(to_rotation(in.rotation(), field + ".rotation", &out->rotation));
-  DP_RETURN_IF_ERROR(to_vec3(in.velocity_mps(), 150.0, field + ".velocity_mps", &out->velocity_mps));
+  DP_RETURN_IF_ERROR(
+      to_vec3(in.velocity_mps(), 150.0, field + ".velocity_mps", &out->velocity_mps));
   return grpc::Status::OK;
 }
 
 grpc::Status to_wipers(const v1::WiperState& in, const std::string& field, sim::WiperState* out) {
   switch (in.mode()) {
-    case v1::WIPER_OFF: out->mode = sim::WiperMode::kOff; break;
-    case v1::WIPER_INTERMITTENT: out->mode = sim::WiperMode::kIntermittent; break;
-    case v1::WIPER_LOW: out->mode = sim::WiperMode::kLow; break;
-    case v1::WIPER_HIGH: out->mode = sim::WiperMode::kHigh; break;
-    case v1::WIPER_SINGLE: out->mode = sim::WiperMode::kSingle; break;
-    case v1::WIPER_MANUAL: out->mode = sim::WiperMode::kManual; break;
+    case v1::WIPER_OFF:
+      out->mode = sim::WiperMode::kOff;
+      break;
+    case v1::WIPER_INTERMITTENT:
+      out->mode = sim::WiperMode::kIntermittent;
+      break;
+    case v1::WIPER_LOW:
+      out->mode = sim::WiperMode::kLow;
+      break;
+    case v1::WIPER_HIGH:
+      out->mode = sim::WiperMode::kHigh;
+      break;
+    case v1::WIPER_SINGLE:
+      out->mode = sim::WiperMode::kSingle;
+      break;
+    case v1::WIPER_MANUAL:
+      out->mode = sim::WiperMode::kManual;
+      break;
     default:
-      return invalid(field + ".mode", "must be one of WIPER_OFF, WIPER_INTERMITTENT, WIPER_LOW, WIPER_HIGH, "
-                                      "WIPER_SINGLE, WIPER_MANUAL, got " + std::to_string(in.mode()));
+      return invalid(field + ".mode",
+                     "must be one of WIPER_OFF, WIPER_INTERMITTENT, WIPER_LOW, WIPER_HIGH, "
+                     "WIPER_SINGLE, WIPER_MANUAL, got " +
+                         std::to_string(in.mode()));
   }
   if (in.interval_s() != 0.0 || !std::isfinite(in.interval_s())) {
     DP_RETURN_IF_ERROR(in_range(in.interval_s(), 0.5, 60.0, field + ".interval_s"));
   }
   out->interval_s = in.interval_s() > 0.0 ? in.interval_s() : 4.0;
   if (in.blade_angle_deg_size() > 2) {
-    return invalid(field + ".blade_angle_deg", "at most 2 blades, got " + std::to_string(in.blade_angle_deg_size()));
+    return invalid(field + ".blade_angle_deg",
+                   "at most 2 blades, got " + std::to_string(in.blade_angle_deg_size()));
   }
   if (out->mode == sim::WiperMode::kManual && in.blade_angle_deg_size() == 0) {
     return invalid(field + ".blade_angle_deg", "WIPER_MANUAL needs at least one blade angle");
   }
   out->blade_angle_deg.clear();
   for (int i = 0; i < in.blade_angle_deg_size(); ++i) {
-    DP_RETURN_IF_ERROR(in_range(in.blade_angle_deg(i), 0.0, 180.0, field + ".blade_angle_deg[" + std::to_string(i) + "]"));
+    DP_RETURN_IF_ERROR(in_range(in.blade_angle_deg(i), 0.0, 180.0,
+                                field + ".blade_angle_deg[" + std::to_string(i) + "]"));
     out->blade_angle_deg.push_back(in.blade_angle_deg(i));
   }
   return grpc::Status::OK;
@@ -94,14 +113,16 @@ grpc::Status to_weather(const v1::Weather& in, const std::string& f, sim::Weathe
   DP_RETURN_IF_ERROR(in_range(in.sun_azimuth_deg(), -360.0, 360.0, f + ".sun_azimuth_deg"));
   DP_RETURN_IF_ERROR(in_range(in.rain_streak_count(), 0.0, 80000.0, f + ".rain_streak_count"));
   DP_RETURN_IF_ERROR(in_range(in.rain_angle_deg(), -70.0, 70.0, f + ".rain_angle_deg"));
-  *out = {in.rain_rate_mm_h(), in.wind_speed_mps(), in.wind_direction_deg(), in.fog_density(), in.cloudiness(),
-          in.sun_altitude_deg(), in.sun_azimuth_deg(), in.rain_streak_count(), in.rain_angle_deg()};
+  *out = {in.rain_rate_mm_h(),  in.wind_speed_mps(),    in.wind_direction_deg(),
+          in.fog_density(),     in.cloudiness(),        in.sun_altitude_deg(),
+          in.sun_azimuth_deg(), in.rain_streak_count(), in.rain_angle_deg()};
   return grpc::Status::OK;
 }
 
 }  // namespace
 
-grpc::Status to_update(const v1::Update& in, const std::string& field, const Limits& limits, sim::Update* out) {
+grpc::Status to_update(const v1::Update& in, const std::string& field, const Limits& limits,
+                       sim::Update* out) {
   DP_RETURN_IF_ERROR(in_range(in.sim_time_s(), -1e9, 1e9, field + ".sim_time_s"));
   sim::Update u;
   u.client_time_s = in.sim_time_s();
@@ -118,8 +139,8 @@ grpc::Status to_update(const v1::Update& in, const std::string& field, const Lim
     DP_RETURN_IF_ERROR(to_weather(in.weather(), field + ".weather", &*u.weather));
   }
   if (in.traffic_size() > limits.max_traffic) {
-    return invalid(field + ".traffic", "at most " + std::to_string(limits.max_traffic) + " vehicles, got " +
-                                           std::to_string(in.traffic_size()));
+    return invalid(field + ".traffic", "at most " + std::to_string(limits.max_traffic) +
+                                           " vehicles, got " + std::to_string(in.traffic_size()));
   }
   if (in.replace_traffic() || in.traffic_size() > 0) {
     u.traffic.emplace();
@@ -141,31 +162,45 @@ grpc::Status to_update(const v1::Update& in, const std::string& field, const Lim
   return grpc::Status::OK;
 }
 
-grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, const Limits& limits, sim::ViewSpec* out) {
+grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, const Limits& limits,
+                          sim::ViewSpec* out) {
   switch (in.view()) {
-    case v1::VIEW_COCKPIT: out->view = sim::View::kCockpit; break;
-    case v1::VIEW_ROAD: out->view = sim::View::kRoad; break;
-    case v1::VIEW_WINDSHIELD: out->view = sim::View::kWindshield; break;
-    case v1::VIEW_RAIN: out->view = sim::View::kRain; break;
+    case v1::VIEW_COCKPIT:
+      out->view = sim::View::kCockpit;
+      break;
+    case v1::VIEW_ROAD:
+      out->view = sim::View::kRoad;
+      break;
+    case v1::VIEW_WINDSHIELD:
+      out->view = sim::View::kWindshield;
+      break;
+    case v1::VIEW_RAIN:
+      out->view = sim::View::kRain;
+      break;
     default:
-      return invalid(field + ".view", "must be one of VIEW_COCKPIT, VIEW_ROAD, VIEW_WINDSHIELD, VIEW_RAIN, got " +
-                                          std::to_string(in.view()));
+      return invalid(field + ".view",
+                     "must be one of VIEW_COCKPIT, VIEW_ROAD, VIEW_WINDSHIELD, VIEW_RAIN, got " +
+                         std::to_string(in.view()));
   }
   DP_RETURN_IF_ERROR(in_range(in.width(), 16, limits.max_width, field + ".width"));
   DP_RETURN_IF_ERROR(in_range(in.height(), 16, limits.max_height, field + ".height"));
   out->width = static_cast<int>(in.width());
   out->height = static_cast<int>(in.height());
-  if (in.jpeg_quality() != 0) DP_RETURN_IF_ERROR(in_range(in.jpeg_quality(), 1, 100, field + ".jpeg_quality"));
+  if (in.jpeg_quality() != 0)
+    DP_RETURN_IF_ERROR(in_range(in.jpeg_quality(), 1, 100, field + ".jpeg_quality"));
   out->jpeg_quality = in.jpeg_quality() == 0 ? 85 : static_cast<int>(in.jpeg_quality());
   if (in.fov_deg() != 0.0 || !std::isfinite(in.fov_deg())) {
     DP_RETURN_IF_ERROR(in_range(in.fov_deg(), 1.0, 170.0, field + ".fov_deg"));
   }
   out->fov_deg = in.fov_deg();
   if (in.has_camera_position_m() || in.has_camera_rotation()) {
-    if (out->view != sim::View::kRoad) return invalid(field + ".camera_position_m", "a camera pose is for VIEW_ROAD only");
+    if (out->view != sim::View::kRoad)
+      return invalid(field + ".camera_position_m", "a camera pose is for VIEW_ROAD only");
     sim::CameraPose pose;
-    DP_RETURN_IF_ERROR(to_vec3(in.camera_position_m(), 100.0, field + ".camera_position_m", &pose.position_m));
-    DP_RETURN_IF_ERROR(to_rotation(in.camera_rotation(), field + ".camera_rotation", &pose.rotation));
+    DP_RETURN_IF_ERROR(
+        to_vec3(in.camera_position_m(), 100.0, field + ".camera_position_m", &pose.position_m));
+    DP_RETURN_IF_ERROR(
+        to_rotation(in.camera_rotation(), field + ".camera_rotation", &pose.rotation));
     out->camera = pose;
   }
   return grpc::Status::OK;
@@ -175,7 +210,8 @@ grpc::Status to_session_config(const v1::CreateSessionRequest& in, const Limits&
                                session::SessionConfig* config, sim::Update* initial) {
   if (in.views_size() == 0) return invalid("views", "at least one view is needed");
   if (in.views_size() > limits.max_views) {
-    return invalid("views", "at most " + std::to_string(limits.max_views) + " views, got " + std::to_string(in.views_size()));
+    return invalid("views", "at most " + std::to_string(limits.max_views) + " views, got " +
+                                std::to_string(in.views_size()));
   }
   session::SessionConfig c;
   std::set<sim::View> seen;
@@ -183,16 +219,24 @@ grpc::Status to_session_config(const v1::CreateSessionRequest& in, const Limits&
     const std::string field = "views[" + std::to_string(i) + "]";
     sim::ViewSpec spec;
     DP_RETURN_IF_ERROR(to_view_spec(in.views(i), field, limits, &spec));
-    if (!seen.insert(spec.view).second) return invalid(field + ".view", "each view at most once per session");
+    if (!seen.insert(spec.view).second)
+      return invalid(field + ".view", "each view at most once per session");
     c.views.push_back(spec);
   }
   switch (in.mode()) {
     case v1::MODE_UNSPECIFIED:
-    case v1::MODE_REALTIME: c.mode = sim::Mode::kRealtime; break;
-    case v1::MODE_LOCKSTEP: c.mode = sim::Mode::kLockstep; break;
-    default: return invalid("mode", "must be MODE_REALTIME or MODE_LOCKSTEP, got " + std::to_string(in.mode()));
+    case v1::MODE_REALTIME:
+      c.mode = sim::Mode::kRealtime;
+      break;
+    case v1::MODE_LOCKSTEP:
+      c.mode = sim::Mode::kLockstep;
+      break;
+    default:
+      return invalid("mode",
+                     "must be MODE_REALTIME or MODE_LOCKSTEP, got " + std::to_string(in.mode()));
   }
-  if (in.fps() != 0.0 || !std::isfinite(in.fps())) DP_RETURN_IF_ERROR(in_range(in.fps(), 0.1, limits.max_fps, "fps"));
+  if (in.fps() != 0.0 || !std::isfinite(in.fps()))
+    DP_RETURN_IF_ERROR(in_range(in.fps(), 0.1, limits.max_fps, "fps"));
   c.fps = in.fps() > 0.0 ? in.fps() : 30.0;
   c.seed = in.seed();
   DP_RETURN_IF_ERROR(to_update(in.initial(), "initial", limits, initial));
@@ -200,9 +244,11 @@ grpc::Status to_session_config(const v1::CreateSessionRequest& in, const Limits&
   return grpc::Status::OK;
 }
 
-grpc::Status check_dt(double dt_s, const std::string& field, bool allow_zero, const Limits& limits) {
+grpc::Status check_dt(double dt_s, const std::string& field, bool allow_zero,
+                      const Limits& limits) {
   DP_RETURN_IF_ERROR(in_range(dt_s, 0.0, limits.max_dt_s, field));
-  if (!allow_zero && dt_s == 0.0) return invalid(field, "must be in (0, " + number_text(limits.max_dt_s) + "], got 0");
+  if (!allow_zero && dt_s == 0.0)
+    return invalid(field, "must be in (0, " + number_text(limits.max_dt_s) + "], got 0");
   return grpc::Status::OK;
 }
 

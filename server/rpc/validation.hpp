@@ -22,8 +22,10 @@ struct Limits {
   double max_dt_s = 10.0;
 };
 
-grpc::Status to_update(const v1::Update& in, const std::string& field, const Limits& limits, sim::Update* out);
-grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, const Limits& limits, sim::ViewSpec* out);
+grpc::Status to_update(const v1::Update& in, const std::string& field, const Limits& limits,
+                       sim::Update* out);
+grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, const Limits& limits,
+                          sim::ViewSpec* out);
 grpc::Status to_session_config(const v1::CreateSessionRequest& in, const Limits& limits,
                                session::SessionConfig* config, sim::Update* initial);
 // dt_s in (0, max] for Step; [0, max] for Drive (0 = update only).

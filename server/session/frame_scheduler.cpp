@@ -11,9 +11,13 @@ namespace {
 constexpr std::size_t kStatsWindow = 512;
 constexpr double kMaxRealtimeStepS = 0.25;  // a stalled loop does not make the simulation jump
 
-std::uint64_t target_key(std::uint64_t session_number, int view_index) { return session_number * 8 + view_index; }
+std::uint64_t target_key(std::uint64_t session_number, int view_index) {
+  return session_number * 8 + view_index;
+}
 
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -132,7 +136,8 @@ void FrameScheduler::run(std::promise<void>* started) {
     renderer_->set_profiling(options_.profile_passes);
     // Warm-up: a first frame proves the context, shaders and readback before we report ready.
     sim::ViewSpec warm{sim::View::kCockpit, 64, 36, 85, 0.0, std::nullopt};
-    const std::vector<std::uint8_t> pixels = render::render_image(*renderer_, warm, sim::SceneState{});
+    const std::vector<std::uint8_t> pixels =
+        render::render_image(*renderer_, warm, sim::SceneState{});
     renderer_->release_targets([](std::uint64_t) { return true; });
     if (pixels.size() != 64u * 36u * 4u) throw std::runtime_error("warm-up frame came back empty");
     {
@@ -190,14 +195,16 @@ bool FrameScheduler::run_lockstep(const std::shared_ptr<Session>& s) {
 }
 
 bool FrameScheduler::run_realtime(const std::shared_ptr<Session>& s, Clock::time_point now) {
-  const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / s->config().fps));
+  const auto period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(1.0 / s->config().fps));
   if (s->last_tick == Clock::time_point{}) {
     s->last_tick = now - period;
     s->next_due = now;
   }
   if (now < s->next_due) return false;
   s->next_due += period;
-  if (s->next_due < now) s->next_due = now + period;  // fell behind: do not try to catch up in a burst
+  if (s->next_due < now)
+    s->next_due = now + period;  // fell behind: do not try to catch up in a burst
   if (!encoders_.try_reserve(static_cast<int>(s->config().views.size()))) {
     ++ticks_skipped_;
     return false;
@@ -207,7 +214,8 @@ bool FrameScheduler::run_realtime(const std::shared_ptr<Session>& s, Clock::time
     s->simulation().apply(update->first);
     arrived = update->second;
   }
-  const double dt = std::min(std::chrono::duration<double>(now - s->last_tick).count(), kMaxRealtimeStepS);
+  const double dt =
+      std::min(std::chrono::duration<double>(now - s->last_tick).count(), kMaxRealtimeStepS);
   s->last_tick = now;
   tick(s, dt, nullptr, arrived);
   return true;

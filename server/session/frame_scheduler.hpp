@@ -59,7 +59,8 @@ class FrameScheduler {
   void run(std::promise<void>* started);
   bool run_lockstep(const std::shared_ptr<Session>& s);
   bool run_realtime(const std::shared_ptr<Session>& s, Clock::time_point now);
-  void tick(const std::shared_ptr<Session>& s, double dt_s, StepDone done, Clock::time_point inputs_arrived);
+  void tick(const std::shared_ptr<Session>& s, double dt_s, StepDone done,
+            Clock::time_point inputs_arrived);
   void collect(bool force_all);
   void release_closed_sessions(const std::vector<std::shared_ptr<Session>>& live);
   void record(std::vector<double>& window, std::size_t& next, double value);
@@ -77,16 +78,17 @@ class FrameScheduler {
   std::atomic<bool> stopping_{false};
 
   mutable std::mutex stats_mutex_;
-  std::string renderer_name_;                  // guarded by stats_mutex_
-  std::vector<double> render_ms_window_;       // guarded by stats_mutex_
-  std::size_t render_ms_next_ = 0;             // guarded by stats_mutex_
-  std::vector<double> encode_ms_window_;       // guarded by stats_mutex_
-  std::size_t encode_ms_next_ = 0;             // guarded by stats_mutex_
+  std::string renderer_name_;                     // guarded by stats_mutex_
+  std::vector<double> render_ms_window_;          // guarded by stats_mutex_
+  std::size_t render_ms_next_ = 0;                // guarded by stats_mutex_
+  std::vector<double> encode_ms_window_;          // guarded by stats_mutex_
+  std::size_t encode_ms_next_ = 0;                // guarded by stats_mutex_
   std::vector<render::PassTiming> pass_timings_;  // guarded by stats_mutex_
   std::atomic<std::uint64_t> frames_rendered_{0};
   std::atomic<std::uint64_t> frames_encoded_{0};
   std::atomic<std::uint64_t> ticks_skipped_{0};
-  // Last, so that it is destroyed first: its workers finish their jobs, which use the members above.
+  // Last, so that it is destroyed first: its workers finish their jobs, which use the members
+  // above.
   encode::EncoderPool encoders_;
 };
 

@@ -4,8 +4,8 @@
 
 namespace downpour::session {
 
-Session::Session(std::string id, std::uint64_t number, SessionConfig config, const sim::Update& initial,
-                 std::function<void()> wake_renderer)
+Session::Session(std::string id, std::uint64_t number, SessionConfig config,
+                 const sim::Update& initial, std::function<void()> wake_renderer)
     : id_(std::move(id)),
       number_(number),
       config_(std::move(config)),

@@ -30,8 +30,8 @@ struct SessionConfig {
 
 struct StepOutcome {
   bool ok = false;
-  std::string error;              // when !ok
-  std::vector<FramePtr> frames;   // one per view, in the session's view order
+  std::string error;             // when !ok
+  std::vector<FramePtr> frames;  // one per view, in the session's view order
 };
 using StepDone = std::function<void(StepOutcome)>;
 
@@ -86,14 +86,14 @@ class Session {
   const std::uint64_t number_;
   const SessionConfig config_;
   const std::function<void()> wake_renderer_;
-  sim::Simulation simulation_;  // render thread only
+  sim::Simulation simulation_;    // render thread only
   std::uint64_t next_frame_ = 1;  // render thread only
 
   mutable std::mutex mutex_;
-  std::deque<StepJob> jobs_;                                    // guarded by mutex_
-  std::optional<sim::Update> inbox_;                            // guarded by mutex_
-  Clock::time_point inbox_arrived_;                             // guarded by mutex_
-  std::vector<std::weak_ptr<FrameSink>> sinks_;                 // guarded by mutex_
+  std::deque<StepJob> jobs_;                     // guarded by mutex_
+  std::optional<sim::Update> inbox_;             // guarded by mutex_
+  Clock::time_point inbox_arrived_;              // guarded by mutex_
+  std::vector<std::weak_ptr<FrameSink>> sinks_;  // guarded by mutex_
   std::atomic<bool> closed_{false};
   std::atomic<std::uint64_t> frames_rendered_{0};
   std::atomic<double> sim_time_s_{0.0};

@@ -32,7 +32,7 @@ class SessionRegistry {
   mutable std::mutex mutex_;
   std::map<std::string, std::shared_ptr<Session>> sessions_;  // guarded by mutex_
   std::uint64_t next_number_ = 1;                             // guarded by mutex_
-  std::uint64_t id_salt_;                                     // random, so that ids are not guessable
+  std::uint64_t id_salt_;  // random, so that ids are not guessable
 };
 
 }  // namespace downpour::session

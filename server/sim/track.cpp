@@ -86,7 +86,8 @@ TrackFrame Track::at(double s_in) const {
     const double r = 1.0 / seg->curvature;
     f.heading_rad = seg->heading0 + d * seg->curvature;
     // Centre of the circle lies to the left of the start heading for a left turn.
-    const glm::dvec2 centre = seg->start + r * glm::dvec2(-std::sin(seg->heading0), std::cos(seg->heading0));
+    const glm::dvec2 centre =
+        seg->start + r * glm::dvec2(-std::sin(seg->heading0), std::cos(seg->heading0));
     xy = centre + r * glm::dvec2(std::sin(f.heading_rad), -std::cos(f.heading_rad));
   }
   f.position = glm::dvec3(xy, elevation(s));
@@ -99,9 +100,7 @@ double Track::surface_height(double s, double lateral) const {
   return elevation(s) - section_.crown_slope * std::min(std::abs(lateral), paved_half_width());
 }
 
-double Track::lane_centre(int lane) const {
-  return -(lane + 0.5) * section_.lane_width_m;
-}
+double Track::lane_centre(int lane) const { return -(lane + 0.5) * section_.lane_width_m; }
 
 Track::Projection Track::project(glm::dvec2 xy, double fine_within_m) const {
   // Coarse search over the samples, then a fine search around the best one.

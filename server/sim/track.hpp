@@ -10,10 +10,10 @@
 namespace downpour::sim {
 
 struct TrackFrame {
-  glm::dvec3 position{0.0};  // centreline point, world frame
-  double heading_rad = 0.0;  // direction of travel, counter-clockwise from +x
-  double grade = 0.0;        // dz/ds along the centreline
-  glm::dvec2 left{0.0, 1.0}; // unit vector to the left of the direction of travel (horizontal)
+  glm::dvec3 position{0.0};   // centreline point, world frame
+  double heading_rad = 0.0;   // direction of travel, counter-clockwise from +x
+  double grade = 0.0;         // dz/ds along the centreline
+  glm::dvec2 left{0.0, 1.0};  // unit vector to the left of the direction of travel (horizontal)
 };
 
 struct CrossSection {

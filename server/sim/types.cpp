@@ -12,10 +12,14 @@ void Update::merge_from(const Update& later) {
 
 std::string_view view_name(View view) {
   switch (view) {
-    case View::kCockpit: return "COCKPIT";
-    case View::kRoad: return "ROAD";
-    case View::kWindshield: return "WINDSHIELD";
-    case View::kRain: return "RAIN";
+    case View::kCockpit:
+      return "COCKPIT";
+    case View::kRoad:
+      return "ROAD";
+    case View::kWindshield:
+      return "WINDSHIELD";
+    case View::kRain:
+      return "RAIN";
   }
   return "UNKNOWN";
 }

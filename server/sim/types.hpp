@@ -78,7 +78,7 @@ struct ViewSpec {
   int width = 640;
   int height = 360;
   int jpeg_quality = 85;
-  double fov_deg = 0.0;               // 0 = the view's default
+  double fov_deg = 0.0;              // 0 = the view's default
   std::optional<CameraPose> camera;  // kRoad only; absent = chase camera
 };
 

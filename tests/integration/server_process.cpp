@@ -20,7 +20,8 @@ ServerProcess::ServerProcess(std::vector<std::string> extra_args) {
   if (!mkdtemp(tmpl)) throw std::runtime_error("mkdtemp failed");
   dir_ = tmpl;
   const std::string port_file = dir_ + "/port";
-  std::vector<std::string> args = {binary, "--listen", "127.0.0.1:0", "--port-file", port_file, "--log-level", "warn"};
+  std::vector<std::string> args = {binary,    "--listen",    "127.0.0.1:0", "--port-file",
+                                   port_file, "--log-level", "warn"};
   args.insert(args.end(), extra_args.begin(), extra_args.end());
   pid_ = fork();
   if (pid_ == 0) {
@@ -36,7 +37,8 @@ ServerProcess::ServerProcess(std::vector<std::string> extra_args) {
     std::ifstream in(port_file);
     if (in >> port) break;
     int status = 0;
-    if (waitpid(pid_, &status, WNOHANG) == pid_) throw std::runtime_error("the server exited during start-up");
+    if (waitpid(pid_, &status, WNOHANG) == pid_)
+      throw std::runtime_error("the server exited during start-up");
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   if (port.empty()) throw std::runtime_error("the server did not write its port within 60 s");

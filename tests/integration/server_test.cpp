@@ -82,7 +82,8 @@ class ServerTest : public ::testing::Test {
  protected:
   std::unique_ptr<Downpour::Stub> stub = Downpour::NewStub(g_server->channel());
 
-  std::string create(v1::Mode mode, std::vector<v1::ViewSpec> views, std::uint64_t seed = 1, double fps = 0.0) {
+  std::string create(v1::Mode mode, std::vector<v1::ViewSpec> views, std::uint64_t seed = 1,
+                     double fps = 0.0) {
     v1::CreateSessionRequest req;
     for (auto& v : views) *req.add_views() = v;
     req.set_mode(mode);
@@ -125,7 +126,8 @@ TEST_F(ServerTest, HealthIsServing) {
 }
 
 TEST_F(ServerTest, LockstepStepReturnsDecodableFramesInOrder) {
-  const std::string id = create(v1::MODE_LOCKSTEP, {view(v1::VIEW_COCKPIT, 160, 90), view(v1::VIEW_ROAD, 128, 72)});
+  const std::string id =
+      create(v1::MODE_LOCKSTEP, {view(v1::VIEW_COCKPIT, 160, 90), view(v1::VIEW_ROAD, 128, 72)});
   for (int i = 1; i <= 4; ++i) {
     v1::StepResponse resp;
     const grpc::Status s = step(id, i * 0.05, 0.05, &resp);
@@ -234,20 +236,33 @@ TEST_F(ServerTest, BadInputGetsAClearStatusAndTheServerKeepsServing) {
   };
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const std::vector<Case> cases = {
-      {"rain over 500", [](auto& r) { r.mutable_initial()->mutable_weather()->set_rain_rate_mm_h(600); }, "rain_rate_mm_h"},
-      {"negative rain", [](auto& r) { r.mutable_initial()->mutable_weather()->set_rain_rate_mm_h(-1); }, "rain_rate_mm_h"},
-      {"NaN position", [nan](auto& r) { r.mutable_initial()->mutable_vehicle()->mutable_position_m()->set_x(nan); }, "position_m.x"},
-      {"infinite speed", [](auto& r) {
-         r.mutable_initial()->mutable_vehicle()->mutable_velocity_mps()->set_y(std::numeric_limits<double>::infinity());
-       }, "velocity_mps.y"},
+      {"rain over 500",
+       [](auto& r) { r.mutable_initial()->mutable_weather()->set_rain_rate_mm_h(600); },
+       "rain_rate_mm_h"},
+      {"negative rain",
+       [](auto& r) { r.mutable_initial()->mutable_weather()->set_rain_rate_mm_h(-1); },
+       "rain_rate_mm_h"},
+      {"NaN position",
+       [nan](auto& r) { r.mutable_initial()->mutable_vehicle()->mutable_position_m()->set_x(nan); },
+       "position_m.x"},
+      {"infinite speed",
+       [](auto& r) {
+         r.mutable_initial()->mutable_vehicle()->mutable_velocity_mps()->set_y(
+             std::numeric_limits<double>::infinity());
+       },
+       "velocity_mps.y"},
       {"width 0", [](auto& r) { r.mutable_views(0)->set_width(0); }, "views[0].width"},
-      {"width over the limit", [](auto& r) { r.mutable_views(0)->set_width(100000); }, "views[0].width"},
+      {"width over the limit", [](auto& r) { r.mutable_views(0)->set_width(100000); },
+       "views[0].width"},
       {"quality 101", [](auto& r) { r.mutable_views(0)->set_jpeg_quality(101); }, "jpeg_quality"},
-      {"unknown view", [](auto& r) { r.mutable_views(0)->set_view(static_cast<v1::View>(42)); }, "views[0].view"},
+      {"unknown view", [](auto& r) { r.mutable_views(0)->set_view(static_cast<v1::View>(42)); },
+       "views[0].view"},
       {"unknown mode", [](auto& r) { r.set_mode(static_cast<v1::Mode>(9)); }, "mode"},
-      {"unknown wiper mode", [](auto& r) {
+      {"unknown wiper mode",
+       [](auto& r) {
          r.mutable_initial()->mutable_wipers()->set_mode(static_cast<v1::WiperMode>(77));
-       }, "wipers.mode"},
+       },
+       "wipers.mode"},
       {"no views", [](auto& r) { r.clear_views(); }, "views"},
   };
   for (const Case& c : cases) {
@@ -259,7 +274,8 @@ TEST_F(ServerTest, BadInputGetsAClearStatusAndTheServerKeepsServing) {
     v1::SessionInfo info;
     const grpc::Status s = stub->CreateSession(&ctx, req, &info);
     EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << c.name;
-    EXPECT_NE(s.error_message().find(c.field), std::string::npos) << c.name << ": " << s.error_message();
+    EXPECT_NE(s.error_message().find(c.field), std::string::npos)
+        << c.name << ": " << s.error_message();
   }
   // Unknown session, bad dt, Step on a realtime session.
   v1::StepResponse resp;
@@ -306,7 +322,8 @@ TEST_F(ServerTest, StalledReaderNeitherGrowsMemoryNorSlowsAnotherSession) {
       const auto t0 = std::chrono::steady_clock::now();
       v1::StepResponse resp;
       EXPECT_TRUE(step(ls, i * 0.05, 0.05, &resp).ok());
-      ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
     std::nth_element(ms.begin(), ms.begin() + n / 2, ms.end());
     return ms[n / 2];
@@ -319,22 +336,24 @@ TEST_F(ServerTest, StalledReaderNeitherGrowsMemoryNorSlowsAnotherSession) {
   args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
   args.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 64 * 1024);
   args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
-  auto stalled_stub =
-      Downpour::NewStub(grpc::CreateCustomChannel(g_server->target(), grpc::InsecureChannelCredentials(), args));
+  auto stalled_stub = Downpour::NewStub(
+      grpc::CreateCustomChannel(g_server->target(), grpc::InsecureChannelCredentials(), args));
   grpc::ClientContext stalled_ctx;
   v1::WatchFramesRequest req;
   req.set_session_id(rt);
   auto stalled = stalled_stub->WatchFrames(&stalled_ctx, req);  // never Read()
-  std::this_thread::sleep_for(std::chrono::seconds(2));  // flow-control windows fill up
+  std::this_thread::sleep_for(std::chrono::seconds(2));         // flow-control windows fill up
   const long rss_before = g_server->rss_kib();
   const double with_stall = time_steps(15);
   std::this_thread::sleep_for(std::chrono::seconds(3));
   const long rss_after = g_server->rss_kib();
 
   // Bounded: a latest-frame slot holds one frame; 3 s more at 30 fps must not pile up frames.
-  EXPECT_LT(rss_after - rss_before, 16 * 1024) << "RSS grew from " << rss_before << " to " << rss_after << " KiB";
+  EXPECT_LT(rss_after - rss_before, 16 * 1024)
+      << "RSS grew from " << rss_before << " to " << rss_after << " KiB";
   // Another session's steps are not held up by the stalled reader (generous: a 2-core machine).
-  EXPECT_LT(with_stall, baseline * 2.0 + 20.0) << "median step " << baseline << " ms -> " << with_stall << " ms";
+  EXPECT_LT(with_stall, baseline * 2.0 + 20.0)
+      << "median step " << baseline << " ms -> " << with_stall << " ms";
   grpc::ClientContext stats_ctx;
   v1::ServerStats stats;
   ASSERT_TRUE(stub->GetStats(&stats_ctx, v1::GetStatsRequest(), &stats).ok());

@@ -59,18 +59,20 @@ TEST_P(GoldenTest, MatchesGoldenImage) {
     testing::write_png(golden, image);
     GTEST_SKIP() << "wrote " << golden;
   }
-  ASSERT_TRUE(std::filesystem::exists(golden)) << golden << " is missing; run with DOWNPOUR_UPDATE_GOLDEN=1";
+  ASSERT_TRUE(std::filesystem::exists(golden))
+      << golden << " is missing; run with DOWNPOUR_UPDATE_GOLDEN=1";
   const double db = testing::psnr(image, testing::read_png(golden));
   if (db < 32.0) {
     const std::string actual = ::testing::TempDir() + "actual_" + name;
     testing::write_png(actual, image);
-    ADD_FAILURE() << name << ": PSNR " << db << " dB against the golden image; this render: " << actual;
+    ADD_FAILURE() << name << ": PSNR " << db
+                  << " dB against the golden image; this render: " << actual;
   }
 }
 
 INSTANTIATE_TEST_SUITE_P(Views, GoldenTest,
-                         ::testing::Values(sim::View::kCockpit, sim::View::kRoad, sim::View::kWindshield,
-                                           sim::View::kRain),
+                         ::testing::Values(sim::View::kCockpit, sim::View::kRoad,
+                                           sim::View::kWindshield, sim::View::kRain),
                          [](const auto& info) { return std::string(sim::view_name(info.param)); });
 
 TEST_F(RendererTest, SkyDarkensAsTheRainRateRises) {
@@ -95,8 +97,10 @@ TEST_F(RendererTest, WetAsphaltIsDarkerThanDry) {
 
 TEST_F(RendererTest, CockpitShowsTheDashboardBelowTheGlass) {
   const RgbaImage image = render(sim::View::kCockpit, highway_scene(0.0, 0.2));
-  const double dashboard = testing::mean_luma(image, kWidth / 3, kHeight * 9 / 10, kWidth * 2 / 3, kHeight);
-  const double through_glass = testing::mean_luma(image, kWidth / 3, kHeight / 4, kWidth * 2 / 3, kHeight / 2);
+  const double dashboard =
+      testing::mean_luma(image, kWidth / 3, kHeight * 9 / 10, kWidth * 2 / 3, kHeight);
+  const double through_glass =
+      testing::mean_luma(image, kWidth / 3, kHeight / 4, kWidth * 2 / 3, kHeight / 2);
   EXPECT_LT(dashboard, through_glass * 0.5);
 }
 

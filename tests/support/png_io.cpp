@@ -24,7 +24,8 @@ void write_png(const std::string& path, const RgbaImage& image) {
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
   for (int y = 0; y < image.height; ++y) {
-    png_write_row(png, const_cast<png_bytep>(&image.pixels[static_cast<std::size_t>(y) * image.width * 4]));
+    png_write_row(
+        png, const_cast<png_bytep>(&image.pixels[static_cast<std::size_t>(y) * image.width * 4]));
   }
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
@@ -33,7 +34,8 @@ void write_png(const std::string& path, const RgbaImage& image) {
 RgbaImage read_png(const std::string& path) {
   png_image img{};
   img.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&img, path.c_str())) throw std::runtime_error("cannot read " + path);
+  if (!png_image_begin_read_from_file(&img, path.c_str()))
+    throw std::runtime_error("cannot read " + path);
   img.format = PNG_FORMAT_RGBA;
   RgbaImage out{static_cast<int>(img.width), static_cast<int>(img.height), {}};
   out.pixels.resize(PNG_IMAGE_SIZE(img));

@@ -5,7 +5,8 @@
 namespace downpour::render {
 
 CockpitPass::CockpitPass(SharedResources&)
-    : program_("mesh.vert", "cockpit.frag"), interior_(build_cockpit_interior(WindshieldCorners{})) {}
+    : program_("mesh.vert", "cockpit.frag"),
+      interior_(build_cockpit_interior(WindshieldCorners{})) {}
 
 void CockpitPass::draw(const FrameContext& frame) {
   program_.use();

@@ -2,7 +2,8 @@
 
 namespace downpour::render {
 
-SkyPass::SkyPass(SharedResources& shared) : shared_(shared), program_("fullscreen.vert", "sky.frag") {}
+SkyPass::SkyPass(SharedResources& shared)
+    : shared_(shared), program_("fullscreen.vert", "sky.frag") {}
 
 void SkyPass::draw(const FrameContext&) {
   // At depth 0 (infinitely far, reversed-Z): drawn only where nothing else was.

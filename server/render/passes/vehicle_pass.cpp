@@ -22,8 +22,9 @@ void VehiclePass::draw(const FrameContext& frame) {
   const bool cockpit = frame.spec.view == sim::View::kCockpit;
   draw_car(frame.vehicle_to_world, glm::vec3(0.42f, 0.05f, 0.04f), cockpit);
   const glm::mat4 view_proj = frame.camera.projection * frame.camera.view;
-  static const glm::vec3 palette[] = {{0.75f, 0.75f, 0.78f}, {0.05f, 0.06f, 0.08f}, {0.1f, 0.2f, 0.45f},
-                                      {0.55f, 0.55f, 0.5f},  {0.35f, 0.02f, 0.02f}, {0.9f, 0.9f, 0.88f}};
+  static const glm::vec3 palette[] = {{0.75f, 0.75f, 0.78f}, {0.05f, 0.06f, 0.08f},
+                                      {0.1f, 0.2f, 0.45f},   {0.55f, 0.55f, 0.5f},
+                                      {0.35f, 0.02f, 0.02f}, {0.9f, 0.9f, 0.88f}};
   for (const sim::TrafficVehicle& other : frame.scene.traffic) {
     // The car shape is 4.6 x 1.8 x 1.47 m from the rear axle; scale it to the reported size.
     const glm::vec3 scale(other.size_m.x / 4.6, other.size_m.y / 1.8, other.size_m.z / 1.47);

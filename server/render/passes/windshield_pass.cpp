@@ -11,7 +11,8 @@ WindshieldPass::WindshieldPass(SharedResources& shared)
   const WindshieldCorners g;
   const float bottom = glm::length(g.bottom_left - g.bottom_right);
   const float top = glm::length(g.top_left - g.top_right);
-  const float height = glm::length(0.5f * (g.top_left + g.top_right) - 0.5f * (g.bottom_left + g.bottom_right));
+  const float height =
+      glm::length(0.5f * (g.top_left + g.top_right) - 0.5f * (g.bottom_left + g.bottom_right));
   // The glass as a trapezoid in its own plane, in metres; the view fits it with a margin.
   program_.set("u_glass", glm::vec3(bottom, top, height));
 }
@@ -19,7 +20,8 @@ WindshieldPass::WindshieldPass(SharedResources& shared)
 void WindshieldPass::draw(const FrameContext& frame) {
   glDisable(GL_DEPTH_TEST);
   program_.use();
-  program_.set("u_aspect", static_cast<float>(frame.spec.width) / static_cast<float>(frame.spec.height));
+  program_.set("u_aspect",
+               static_cast<float>(frame.spec.width) / static_cast<float>(frame.spec.height));
   shared_.fullscreen.draw();
 }
 
