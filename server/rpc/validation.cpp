@@ -194,8 +194,10 @@ grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, cons
   }
   out->fov_deg = in.fov_deg();
   if (in.has_camera_position_m() || in.has_camera_rotation()) {
-    if (out->view != sim::View::kRoad)
-      return invalid(field + ".camera_position_m", "a camera pose is for VIEW_ROAD only");
+    if (out->view != sim::View::kRoad && out->view != sim::View::kCockpit) {
+      return invalid(field + ".camera_position_m",
+                     "a camera pose is for VIEW_ROAD and VIEW_COCKPIT only");
+    }
     sim::CameraPose pose;
     DP_RETURN_IF_ERROR(
         to_vec3(in.camera_position_m(), 100.0, field + ".camera_position_m", &pose.position_m));

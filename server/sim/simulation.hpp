@@ -2,15 +2,21 @@
 // sub-steps. Later issues add the windshield water, rain and road water here.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "server/sim/types.hpp"
+#include "server/sim/water.hpp"
+#include "server/sim/windshield.hpp"
+#include "server/sim/wipers.hpp"
 
 namespace downpour::sim {
 
 struct SimulationConfig {
   double sub_step_s = 1.0 / 240.0;  // fixed, so that lockstep runs reproduce
+  WindshieldConfig windshield;
 };
 
 // What the renderer reads: a copy, taken on the render thread after a step.
@@ -22,6 +28,8 @@ struct SceneState {
   WiperState wipers;
   Weather weather;
   std::vector<TrafficVehicle> traffic;
+  GlassConfig glass;
+  WindshieldState windshield;  // published once per advance(), not per sub-step
 };
 
 class Simulation {
@@ -33,14 +41,21 @@ class Simulation {
   void advance(double dt_s);
 
   const SceneState& state() const { return state_; }
+  const WaterSim& water() const { return water_; }
+  // The relative air (wind minus the car's velocity) in the vehicle frame, m/s.
+  glm::dvec3 air_velocity_vehicle() const;
 
  private:
   void sub_step();
 
   SimulationConfig config_;
   SceneState state_;
-  std::uint64_t seed_;  // seeds the random streams of the effects that later issues add
+  std::uint64_t seed_;
   double carry_s_ = 0.0;
+  WiperMotion wipers_;
+  WaterSim water_;
+  std::array<BladePose, 2> blades_at_water_step_;
+  int sub_steps_since_water_ = 0;
 };
 
 }  // namespace downpour::sim

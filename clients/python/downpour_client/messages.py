@@ -57,7 +57,7 @@ def rotation(yaw_pitch_roll):
 
 def view_spec(view, width, height, quality=0, fov_deg=0.0, camera_position_m=None,
               camera_rotation_deg=None):
-    """A ViewSpec; camera pose (VIEW_ROAD only) as (x, y, z) and (yaw, pitch, roll)."""
+    """A ViewSpec; camera pose (VIEW_ROAD, or a forward camera for VIEW_COCKPIT) as (x, y, z) and (yaw, pitch, roll)."""
     spec = pb.ViewSpec(view=view_value(view), width=width, height=height,
                        jpeg_quality=quality, fov_deg=fov_deg)
     if camera_position_m is not None:

@@ -196,10 +196,15 @@ TEST(ValidationTest, BadTrafficVehicleIsNamedByIndex) {
   EXPECT_TRUE(invalid_naming(update(u), "update.traffic[1].state.velocity_mps.x"));
 }
 
-TEST(ValidationTest, CameraPoseIsForTheRoadViewOnly) {
-  v1::CreateSessionRequest r = good_request();
+TEST(ValidationTest, CameraPoseIsForTheRoadAndCockpitViewsOnly) {
+  v1::CreateSessionRequest r;
+  *r.add_views() = view(v1::VIEW_WINDSHIELD);
   r.mutable_views(0)->mutable_camera_position_m()->set_x(1.0);
   EXPECT_TRUE(invalid_naming(create(r), "views[0].camera_position_m"));
+  // A forward camera behind the glass is a COCKPIT view with a pose.
+  v1::CreateSessionRequest dash = good_request();
+  dash.mutable_views(0)->mutable_camera_position_m()->set_x(1.9);
+  EXPECT_TRUE(create(dash).ok());
 }
 
 TEST(ValidationTest, SessionId) {

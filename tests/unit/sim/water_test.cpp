@@ -1,0 +1,312 @@
+// The windshield water model (seed 000): invariants of the mesh and particle models, their
+// switching, rain arrival and determinism.
+#include "server/sim/water.hpp"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <glm/geometric.hpp>
+
+#include "server/sim/scenario.hpp"
+#include "server/sim/simulation.hpp"
+#include "server/sim/wipers.hpp"
+
+namespace downpour::sim {
+namespace {
+
+constexpr double kDt = 1.0 / 120.0;
+
+WaterInputs still_inputs(const WiperConfig& wipers = {}) {
+  WaterInputs in;
+  const WiperMotion parked(wipers);
+  in.blades_before = in.blades_after = parked.poses();
+  return in;
+}
+
+double ledger_total(const WaterSim& w) {
+  const WaterLedger& l = w.ledger();
+  return w.mass_on_glass() + l.wiped_off + l.drained + l.evaporated;
+}
+
+TEST(WaterTest, DropRadiusIsAHemisphereOfTheMass) {
+  EXPECT_NEAR(drop_radius_mm(drop_mass_mg(2.2)), 2.2, 1e-12);
+  EXPECT_NEAR(drop_mass_mg(1.0), 2.0 / 3.0 * M_PI, 1e-12);
+  // Atlas et al.: about 4.0, 6.5, 8.0 m/s at 1, 2, 3 mm.
+  EXPECT_NEAR(terminal_speed_mps(1.0), 4.0, 0.1);
+  EXPECT_NEAR(terminal_speed_mps(2.0), 6.5, 0.1);
+  EXPECT_NEAR(terminal_speed_mps(3.0), 8.0, 0.1);
+}
+
+TEST(WaterTest, ADropBelowTheCriticalSizeStaysPut) {
+  WaterSim water({}, 1);
+  const glm::dvec2 at(700.0, 400.0);
+  ASSERT_TRUE(water.add_drop(at, drop_mass_mg(2.1)));
+  for (int i = 0; i < 600; ++i) water.step(kDt, still_inputs());  // 5 s
+  ASSERT_EQ(water.drop_count(), 1u);
+  EXPECT_GE(water.drop_at(at), 0);
+  EXPECT_FALSE(water.drops()[water.drop_at(at)].moving);
+}
+
+TEST(WaterTest, ADropAboveTheCriticalSizeRunsDownAndLeavesATrail) {
+  WaterSim water({}, 1);
+  const glm::dvec2 at(700.0, 600.0);
+  ASSERT_TRUE(water.add_drop(at, drop_mass_mg(3.0)));
+  for (int i = 0; i < 240; ++i) water.step(kDt, still_inputs());  // 2 s
+  int main = -1;
+  std::size_t trails = 0;
+  for (std::size_t i = 0; i < water.drops().size(); ++i) {
+    const auto& d = water.drops()[i];
+    if (!d.alive) continue;
+    if (d.trail) {
+      ++trails;
+    } else {
+      main = static_cast<int>(i);
+    }
+  }
+  ASSERT_GE(main, 0);
+  const auto& d = water.drops()[main];
+  EXPECT_LT(d.pos.y, at.y - 20.0) << "it ran down";
+  EXPECT_LT(std::abs(d.pos.x - at.x), at.y - d.pos.y) << "mostly down, meandering";
+  EXPECT_GT(trails, 3u);
+  EXPECT_NEAR(ledger_total(water), water.ledger().arrived, 1e-9);
+}
+
+TEST(WaterTest, TrailDropsShrinkAndVanish) {
+  WaterSim water({}, 3);
+  ASSERT_TRUE(water.add_drop({700.0, 700.0}, drop_mass_mg(3.0)));
+  for (int i = 0; i < 120; ++i) water.step(kDt, still_inputs());
+  const double evaporated_early = water.ledger().evaporated;
+  // Long after the trail lifetime every trail drop is gone and its water counted as evaporated.
+  for (int i = 0; i < 120 * 30; ++i) water.step(kDt, still_inputs());
+  for (const auto& d : water.drops()) EXPECT_FALSE(d.alive && d.trail);
+  EXPECT_GT(water.ledger().evaporated, evaporated_early);
+  EXPECT_NEAR(ledger_total(water), water.ledger().arrived, 1e-9);
+}
+
+TEST(WaterTest, AMovingDropFusesWithTheDropItMeets) {
+  WaterSim water({}, 5);
+  const glm::dvec2 below(700.0, 300.0);
+  ASSERT_TRUE(water.add_drop(below, drop_mass_mg(2.0)));  // static
+  const int small = water.drop_at(below);
+  const double small_mass = water.drops()[small].mass;
+  ASSERT_TRUE(water.add_drop(below + glm::dvec2(0.0, 16.0), drop_mass_mg(4.0)));  // flows
+  ASSERT_EQ(water.drop_count(), 2u);
+  int steps = 0;
+  while (water.drops()[small].alive && water.drop_at(below) == small && steps++ < 120 * 4) {
+    water.step(kDt, still_inputs());
+  }
+  // The small drop's water is now in the big one (less what that left in trails on the way).
+  double largest = 0.0;
+  for (const auto& d : water.drops()) {
+    if (d.alive && !d.trail) largest = std::max(largest, d.mass);
+  }
+  EXPECT_LT(steps, 120 * 4) << "the drops never met";
+  EXPECT_GT(largest, 0.8 * drop_mass_mg(4.0) + small_mass);
+  EXPECT_NEAR(ledger_total(water), water.ledger().arrived, 1e-9);
+}
+
+TEST(WaterTest, TouchingDropsRunTogether) {
+  WaterSim water({}, 5);
+  ASSERT_TRUE(water.add_drop({700.0, 300.0}, drop_mass_mg(1.5)));
+  ASSERT_TRUE(water.add_drop({702.5, 300.0}, drop_mass_mg(1.5)));  // circles overlap
+  EXPECT_EQ(water.drop_count(), 1u);
+  EXPECT_NEAR(water.mass_on_glass(), 2.0 * drop_mass_mg(1.5), 1e-9);
+}
+
+TEST(WaterTest, AirflowAtSpeedPushesDropsUpTheGlass) {
+  WaterSim water({}, 7);
+  const glm::dvec2 at(760.0, 300.0);
+  ASSERT_TRUE(water.add_drop(at, drop_mass_mg(2.0)));  // below critical: still when parked
+  WaterInputs in = still_inputs();
+  in.air_velocity_mps = {-30.0, 0.0, 0.0};  // 108 km/h, no wind
+  EXPECT_GT(water.drive_per_pin(2.0, in).y, 1.0);
+  for (int i = 0; i < 240; ++i) water.step(kDt, in);
+  double highest = 0.0;
+  for (const auto& d : water.drops()) {
+    if (d.alive && !d.trail) highest = std::max(highest, d.pos.y);
+  }
+  EXPECT_GT(highest, at.y + 20.0);
+}
+
+TEST(WaterTest, FasterDrivingCollectsMoreRain) {
+  auto collected = [](double speed) {
+    WaterSim water({}, 11);
+    WaterInputs in = still_inputs();
+    in.rain_rate_mm_h = 10.0;
+    in.air_velocity_mps = {-speed, 0.0, 0.0};
+    for (int i = 0; i < 240; ++i) water.step(kDt, in);
+    return water.ledger().arrived;
+  };
+  const double parked = collected(0.0), slow = collected(10.0), fast = collected(30.0);
+  EXPECT_GT(parked, 0.0);
+  EXPECT_GT(slow, 1.3 * parked);
+  EXPECT_GT(fast, 1.6 * slow);  // the flux through the glass doubles from 10 to 30 m/s
+}
+
+TEST(WaterTest, ParticlesDoNotOverlapAfterAStep) {
+  WaterSim water({}, 13);
+  const double r = water.config().water.particle_radius_mm;
+  // A tight cluster inside blade 0's region, with the blade turning slowly so the region holds.
+  WiperMotion wipers(water.config().wipers);
+  WaterInputs in;
+  WiperState low{WiperMode::kLow, 4.0, {}};
+  for (int i = 0; i < 30; ++i) wipers.advance(kDt, low);  // up off the bottom edge
+  in.blades_before = wipers.poses();
+  wipers.advance(kDt, low);
+  in.blades_after = wipers.poses();
+  const BladePose& b = in.blades_after[0];
+  const glm::dvec2 dir(std::cos(b.angle_rad), std::sin(b.angle_rad)), ahead(-dir.y, dir.x);
+  const glm::dvec2 centre =
+      glm::dvec2(b.pivot_mm) + 400.0 * dir + (0.5 * b.width_mm + 4.0 * r) * ahead;
+  // What a conversion leaves: a few particles jittered about each converted drop, overlapping,
+  // two of them exactly on top of each other.
+  for (int k = 0; k < 3; ++k) {
+    const glm::dvec2 at = centre + (40.0 * k) * dir;
+    water.add_particle(at, 1.0);
+    water.add_particle(at + glm::dvec2(0.4 * r, 0.3 * r) * double(k), 1.0);
+    water.add_particle(at + glm::dvec2(-0.5 * r, 0.6 * r), 1.0);
+  }
+  water.step(kDt, in);
+  ASSERT_EQ(water.particles().size(), 9u) << "still particles, inside the moving region";
+  double closest = 1e9;
+  for (std::size_t i = 0; i < water.particles().size(); ++i) {
+    for (std::size_t j = i + 1; j < water.particles().size(); ++j) {
+      closest = std::min(closest, glm::length(water.particles()[i].pos - water.particles()[j].pos));
+    }
+  }
+  EXPECT_GE(closest, 2.0 * r * 0.95) << "overlap left after the step (5% tolerance)";
+}
+
+TEST(WaterTest, SuspensionHoldsParticlesNearALargeDropAndReleasesThemAfter) {
+  WaterSim water({}, 17);
+  const glm::dvec2 big(700.0, 500.0);
+  ASSERT_TRUE(water.add_drop(big, drop_mass_mg(2.8)));  // above critical: it will flow away
+  const glm::dvec2 p = big + glm::dvec2(6.0, 0.0);      // 3 cells away: within 7 x 7
+  water.add_particle(p, 1.0);
+  water.step(kDt, still_inputs());  // parked blades: no region, so only suspension holds it
+  ASSERT_EQ(water.particles().size(), 1u) << "suspended next to a large drop";
+  for (int i = 0; i < 240 && !water.particles().empty(); ++i) water.step(kDt, still_inputs());
+  EXPECT_TRUE(water.particles().empty()) << "released once the drop ran away";
+  EXPECT_GE(water.drop_at(p), 0) << "as a mesh drop at its cell";
+}
+
+TEST(WaterTest, AParticleAwayFromBladesAndLargeDropsBecomesAMeshDrop) {
+  WaterSim water({}, 19);
+  water.add_particle({500.0, 500.0}, 1.0);
+  water.step(kDt, still_inputs());
+  EXPECT_TRUE(water.particles().empty());
+  EXPECT_EQ(water.drop_count(), 1u);
+  EXPECT_NEAR(water.mass_on_glass(), 1.0, 1e-12);
+}
+
+// Small drops every 6 mm over the glass, one wipe at low speed: blade 0's swept sector is left
+// nearly dry, the water pushed to the end of the sweep or off the bottom edge.
+TEST(WaterTest, ABladeSweepLeavesItsSectorNearlyDry) {
+  WaterSim water({}, 23);
+  for (double v = 3.0; v < 760.0; v += 6.0) {
+    for (double u = 3.0; u < 1520.0; u += 6.0) water.add_drop({u, v}, 0.5);
+  }
+  const BladeConfig& blade = water.config().wipers.blades[0];
+  auto in_sector = [&](glm::dvec2 p) {
+    const glm::dvec2 rel = p - blade.pivot_mm;
+    const double r = glm::length(rel), a = std::atan2(rel.y, rel.x) * 180.0 / M_PI;
+    // Inside the sector, away from its ends where the pushed water collects.
+    return r > 150.0 && r < blade.length_mm - 20.0 && a > blade.park_deg + 15.0 &&
+           a < blade.park_deg + blade.sweep_deg - 15.0;
+  };
+  auto sector_mass = [&] {
+    double m = 0.0;
+    for (const auto& d : water.drops()) {
+      if (d.alive && in_sector(d.pos)) m += d.mass;
+    }
+    for (const auto& p : water.particles()) {
+      if (in_sector(p.pos)) m += p.mass;
+    }
+    return m;
+  };
+  const double before = sector_mass();
+  ASSERT_GT(before, 1000.0);
+  WiperMotion wipers(water.config().wipers);
+  WiperState single{WiperMode::kSingle, 4.0, {}};
+  WaterInputs in;
+  for (int i = 0; i < 120 * 2; ++i) {  // one cycle at 45 per minute takes 1.33 s
+    in.blades_before = wipers.poses();
+    wipers.advance(kDt, single);
+    in.blades_after = wipers.poses();
+    water.step(kDt, in);
+  }
+  ASSERT_TRUE(wipers.parked());
+  const double after = sector_mass();
+  EXPECT_LT(after, 0.05 * before) << "before " << before << " mg, after " << after << " mg";
+  EXPECT_GT(water.ledger().wiped_off, 0.0);
+  EXPECT_NEAR(ledger_total(water), water.ledger().arrived, 1e-6);
+}
+
+// In = on the glass + wiped off + drained + evaporated, through rain, fusion, trails, both
+// conversions and wiping: the standard heavy-rain drive for 6 s.
+TEST(WaterTest, MassIsConservedInTheHeavyRainDrive) {
+  const Scenario scenario = highway_heavy_rain();
+  Simulation simulation(scenario.seed, scenario.at(0.0));
+  for (int i = 0; i < 6 * 30; ++i) {
+    simulation.apply(scenario.at((i + 1) / 30.0));
+    simulation.advance(1.0 / 30.0);
+  }
+  const WaterSim& water = simulation.water();
+  const WaterLedger& l = water.ledger();
+  EXPECT_GT(l.arrived, 10000.0);
+  EXPECT_GT(l.wiped_off, 0.0);
+  EXPECT_GT(l.evaporated, 0.0);
+  EXPECT_NEAR(ledger_total(water), l.arrived, 1e-9 * l.arrived);
+  const WindshieldState& w = simulation.state().windshield;
+  EXPECT_EQ(w.drops, water.drop_count());
+  EXPECT_GT(w.metaballs.size(), w.drops);
+  EXPECT_GT(w.glass_wet_fraction, 0.0);
+  EXPECT_LT(w.glass_wet_fraction, 1.0);
+}
+
+TEST(WaterTest, SameSeedSameWaterOtherSeedOtherWater) {
+  const Scenario scenario = highway_heavy_rain();
+  auto run = [&](std::uint64_t seed) {
+    Simulation simulation(seed, scenario.at(0.0));
+    for (int i = 0; i < 30; ++i) {
+      simulation.apply(scenario.at((i + 1) / 30.0));
+      simulation.advance(1.0 / 30.0);
+    }
+    return simulation.state().windshield.metaballs;
+  };
+  auto same = [](const std::vector<Metaball>& a, const std::vector<Metaball>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (a[i].u_mm != b[i].u_mm || a[i].v_mm != b[i].v_mm || a[i].radius_mm != b[i].radius_mm)
+        return false;
+    }
+    return true;
+  };
+  const auto first = run(7), again = run(7), other = run(8);
+  ASSERT_FALSE(first.empty());
+  EXPECT_TRUE(same(first, again));
+  EXPECT_FALSE(same(first, other));
+}
+
+TEST(WaterTest, CoverageGridAgreesWithTheWetFraction) {
+  WaterSim water({}, 29);
+  WindshieldState dry;
+  water.publish(dry);
+  EXPECT_EQ(dry.glass_wet_fraction, 0.0);
+  // Large drops over the left half of the glass.
+  for (double v = 10.0; v < 750.0; v += 9.0) {
+    for (double u = 10.0; u < 700.0; u += 9.0) water.add_drop({u, v}, drop_mass_mg(4.4), false);
+  }
+  WindshieldState wet;
+  water.publish(wet);
+  EXPECT_GT(wet.glass_wet_fraction, 0.3);
+  EXPECT_LT(wet.glass_wet_fraction, 0.6);
+  ASSERT_EQ(wet.coverage.size(),
+            static_cast<std::size_t>(wet.coverage_width) * wet.coverage_height);
+  const int row = wet.coverage_height / 2;
+  EXPECT_GT(wet.coverage[row * wet.coverage_width + 40], 200);                     // left: wet
+  EXPECT_EQ(wet.coverage[row * wet.coverage_width + wet.coverage_width - 40], 0);  // right: dry
+}
+
+}  // namespace
+}  // namespace downpour::sim
