@@ -38,7 +38,8 @@ int main(int argc, char** argv) {
   app.add_flag("--trace", trace, "print the load every simulated second on stderr");
   CLI11_PARSE(app, argc, argv);
 
-  const sim::Scenario scenario = scene == "city_drizzle" ? sim::city_drizzle() : sim::highway_heavy_rain();
+  const sim::Scenario scenario =
+      scene == "city_drizzle" ? sim::city_drizzle() : sim::highway_heavy_rain();
   sim::Simulation simulation(scenario.seed, scenario.at(0.0));
   std::vector<double> step_ms;
   std::vector<double> metaballs, drops, particles, wet;
