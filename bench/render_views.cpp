@@ -1,32 +1,170 @@
 // Renders the views of a standard scene at a given time to PNG files, to look at what the
-// renderer draws. Usage: downpour-render-views OUT_DIR [highway_heavy_rain|city_drizzle] [t_s]
-//   [width height] [rain_rate_mm_h]
+// renderer draws. Usage:
+//   downpour-render-views OUT_DIR [highway_heavy_rain|city_drizzle] [t_s] [width height]
+//     [rain_rate_mm_h] [--windshield N] [--blades A B] [--dash] [--measure FRAMES]
+// --windshield N: a hand-made rainy windshield (tests/render/windshield_fixture.hpp) of about N
+//   metaballs instead of the simulation's, with the wiper blades at A and B degrees from +u
+//   (--blades; default 40 36); N = 0: the render tests' golden windshield. --dash: also the COCKPIT
+//   view from the forward (dash) camera.
+// --measure FRAMES: median costs over FRAMES frames of each COCKPIT and WINDSHIELD view: whole
+//   frames with profiling off, wall and CPU time of all threads (and the same frame with a dry
+//   windshield, no blades), then each
+//   pass with profiling on, in a renderer of its own (a glFinish mid-frame slows llvmpipe).
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
+#include <map>
 #include <string>
+#include <vector>
 
+#include "server/render/camera.hpp"
 #include "server/render/renderer.hpp"
+#include "server/render/view_wet_fraction.hpp"
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"
+#include "tests/render/windshield_fixture.hpp"
 #include "tests/support/png_io.hpp"
 
+namespace {
+
+using namespace downpour;
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+// CPU time of the process (every llvmpipe thread): steadier than wall time on a busy machine.
+double cpu_time_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
+
+struct NamedView {
+  std::string name;
+  sim::ViewSpec spec;
+};
+
+void measure(const std::vector<NamedView>& views, const sim::SceneState& wet, int frames) {
+  const sim::SceneState dry = [&] {
+    sim::SceneState s = wet;
+    s.windshield = sim::WindshieldState{};
+    return s;
+  }();
+  {
+    auto renderer = render::Renderer::create({});
+    for (const NamedView& v : views) {
+      for (const auto* scene : {&wet, &dry}) {
+        std::vector<double> ms, cpu_ms;
+        for (int i = 0; i < frames + 2; ++i) {
+          const double c0 = cpu_time_ms();
+          const auto t0 = std::chrono::steady_clock::now();
+          render::render_image(*renderer, v.spec, *scene);
+          const auto t1 = std::chrono::steady_clock::now();
+          if (i < 2) continue;
+          ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+          cpu_ms.push_back(cpu_time_ms() - c0);
+        }
+        std::printf("%s %dx%d %s frame (profiling off): median %.2f ms, CPU %.2f ms\n",
+                    v.name.c_str(), v.spec.width, v.spec.height, scene == &wet ? "wet" : "dry",
+                    median(ms), median(cpu_ms));
+      }
+    }
+  }
+  auto renderer = render::Renderer::create({});
+  renderer->set_profiling(true);
+  for (const NamedView& v : views) {
+    std::map<std::string, std::vector<double>> passes;
+    std::vector<std::string> order;
+    for (int i = 0; i < frames + 2; ++i) {
+      render::render_image(*renderer, v.spec, wet);
+      if (i < 2) continue;
+      for (const auto& p : renderer->last_pass_timings()) {
+        if (!passes.count(p.name)) order.push_back(p.name);
+        passes[p.name].push_back(p.ms);
+      }
+    }
+    std::printf("%s %dx%d passes (profiling on, median ms):", v.name.c_str(), v.spec.width,
+                v.spec.height);
+    for (const std::string& name : order)
+      std::printf(" %s %.2f", name.c_str(), median(passes[name]));
+    std::printf("\n");
+  }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  using namespace downpour;
-  if (argc < 2) {
+  std::vector<std::string> positional;
+  int windshield_metaballs = -1;
+  std::array<double, 2> blades{40.0, 36.0};
+  bool dash = false;
+  int measure_frames = 0;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--windshield" && i + 1 < argc) {
+      windshield_metaballs = std::atoi(argv[++i]);
+    } else if (arg == "--blades" && i + 2 < argc) {
+      blades = {std::atof(argv[i + 1]), std::atof(argv[i + 2])};
+      i += 2;
+    } else if (arg == "--dash") {
+      dash = true;
+    } else if (arg == "--measure" && i + 1 < argc) {
+      measure_frames = std::atoi(argv[++i]);
+    } else {
+      positional.push_back(arg);
+    }
+  }
+  if (positional.empty()) {
     std::fprintf(stderr,
-                 "usage: downpour-render-views OUT_DIR [scene] [t_s] [width height] [rain_mm_h]\n");
+                 "usage: downpour-render-views OUT_DIR [scene] [t_s] [width height] [rain_mm_h]"
+                 " [--windshield N] [--blades A B] [--dash] [--measure FRAMES]\n");
     return 2;
   }
-  const std::string out = argv[1];
-  const std::string scene_name = argc > 2 ? argv[2] : "highway_heavy_rain";
-  const double t = argc > 3 ? std::atof(argv[3]) : 10.0;
-  const int width = argc > 5 ? std::atoi(argv[4]) : 640;
-  const int height = argc > 5 ? std::atoi(argv[5]) : 360;
+  const std::string out = positional[0];
+  const std::string scene_name = positional.size() > 1 ? positional[1] : "highway_heavy_rain";
+  const double t = positional.size() > 2 ? std::atof(positional[2].c_str()) : 10.0;
+  const int width = positional.size() > 4 ? std::atoi(positional[3].c_str()) : 640;
+  const int height = positional.size() > 4 ? std::atoi(positional[4].c_str()) : 360;
   const sim::Scenario scenario =
       scene_name == "city_drizzle" ? sim::city_drizzle() : sim::highway_heavy_rain();
   sim::Update update = scenario.at(t);
-  if (argc > 6 && update.weather) update.weather->rain_rate_mm_h = std::atof(argv[6]);
+  if (positional.size() > 5 && update.weather)
+    update.weather->rain_rate_mm_h = std::atof(positional[5].c_str());
+
+  sim::Simulation simulation(scenario.seed, update);
+  simulation.advance(t);
+  sim::SceneState scene = simulation.state();
+  if (windshield_metaballs == 0) {
+    scene.windshield = testing::golden_windshield(scene.glass);
+  } else if (windshield_metaballs > 0) {
+    scene.windshield = testing::rainy_windshield(scene.glass, windshield_metaballs, blades);
+  }
+  std::printf("windshield: %zu metaballs, glass wet fraction %.3f\n",
+              scene.windshield.metaballs.size(), scene.windshield.glass_wet_fraction);
+
+  std::vector<NamedView> views;
+  for (sim::View view :
+       {sim::View::kCockpit, sim::View::kRoad, sim::View::kWindshield, sim::View::kRain}) {
+    views.push_back({std::string(sim::view_name(view)), {view, width, height, 85, 0.0, {}}});
+  }
+  if (dash) {
+    views.push_back({"COCKPIT_dash",
+                     {sim::View::kCockpit, width, height, 85, 0.0, render::dash_camera_pose()}});
+  }
+
+  if (measure_frames > 0) {
+    std::vector<NamedView> measured;
+    for (const NamedView& v : views) {
+      if (v.spec.view == sim::View::kCockpit || v.spec.view == sim::View::kWindshield)
+        measured.push_back(v);
+    }
+    measure(measured, scene, measure_frames);
+    return 0;
+  }
 
   const auto t0 = std::chrono::steady_clock::now();
   auto renderer = render::Renderer::create({});
@@ -34,18 +172,13 @@ int main(int argc, char** argv) {
   std::printf("renderer %s, created in %.0f ms\n", renderer->gl_renderer().c_str(),
               std::chrono::duration<double, std::milli>(t1 - t0).count());
   renderer->set_profiling(true);
-  sim::Simulation simulation(scenario.seed, update);
-  simulation.advance(t);
-  for (sim::View view :
-       {sim::View::kCockpit, sim::View::kRoad, sim::View::kWindshield, sim::View::kRain}) {
-    sim::ViewSpec spec{view, width, height, 85, 0.0, std::nullopt};
-    render::render_image(*renderer, spec,
-                         simulation.state());  // the first draw compiles shader variants
-    testing::RgbaImage image{width, height,
-                             render::render_image(*renderer, spec, simulation.state())};
-    std::string path = out + "/" + std::string(sim::view_name(view)) + ".png";
+  for (const NamedView& v : views) {
+    render::render_image(*renderer, v.spec, scene);  // the first draw compiles shader variants
+    testing::RgbaImage image{width, height, render::render_image(*renderer, v.spec, scene)};
+    std::string path = out + "/" + v.name + ".png";
     testing::write_png(path, image);
-    std::printf("%s:", path.c_str());
+    std::printf("%s (view wet fraction %.3f):", path.c_str(),
+                render::view_wet_fraction(v.spec, scene));
     for (const auto& pass : renderer->last_pass_timings())
       std::printf(" %s %.2f ms", pass.name.c_str(), pass.ms);
     std::printf("\n");

@@ -1,19 +1,31 @@
 #version 450
-// The glass in its own plane, fitted to the view: dry glass is black (no water); its outline is
-// drawn faintly so that the image shows where the glass is.
+// The WINDSHIELD view: the glass in its own plane fitted to the view. Dry glass is black; water is
+// grey by its compressed height (0.35 at the threshold up to 1 a quarter above it); the outline is
+// faint grey so that the image shows where the glass is; wiper blades are blue.
+#include "windshield_common.glsl"
 in vec2 v_uv;
 out vec4 out_colour;
-uniform vec3 u_glass;  // bottom width, top width, height (m)
+layout(binding = 5) uniform sampler2D water_tex;  // WindshieldWaterPass's water map
+uniform vec3 u_glass_mm;  // bottom width, top width, height
+uniform vec2 u_map_origin_mm;  // the water map covers u_map_extent_mm from here
+uniform vec2 u_map_extent_mm;
 uniform float u_aspect;
+uniform float u_threshold;
 void main() {
-  float margin = 1.1;
-  float scale = max(u_glass.x / u_aspect, u_glass.z) * margin;  // metres across the view's height
-  vec2 p = (v_uv - 0.5) * vec2(u_aspect, 1.0) * scale;           // metres, origin at the glass centre
-  float v = p.y / u_glass.z + 0.5;                                // 0 bottom .. 1 top edge
-  float half_width = 0.5 * mix(u_glass.x, u_glass.y, clamp(v, 0.0, 1.0));
-  float inside = step(abs(p.x), half_width) * step(0.0, v) * step(v, 1.0);
-  float edge_dist = min(half_width - abs(p.x), min(v, 1.0 - v) * u_glass.z);
+  float scale = max(u_glass_mm.x / u_aspect, u_glass_mm.z) * 1.1;  // mm across the view's height
+  vec2 p = (v_uv - 0.5) * vec2(u_aspect, 1.0) * scale;             // mm from the glass's centre
+  vec2 mm = p + 0.5 * u_glass_mm.xz;                                // glass space
+  float half_width = 0.5 * mix(u_glass_mm.x, u_glass_mm.y, clamp(mm.y / u_glass_mm.z, 0.0, 1.0));
+  float edge_dist = min(half_width - abs(p.x), min(mm.y, u_glass_mm.z - mm.y));
   float px = fwidth(p.x);
+  float inside = clamp(edge_dist / px + 0.5, 0.0, 1.0);
   float outline = inside * (1.0 - smoothstep(px, 2.0 * px, edge_dist));
-  out_colour = vec4(vec3(0.25 * outline), 1.0);
+
+  vec4 water = textureLod(water_tex, (mm - u_map_origin_mm) / u_map_extent_mm, 0.0);
+  float grey = 0.35 + 0.65 * clamp((water.b - u_threshold) * 4.0, 0.0, 1.0);
+  vec3 colour = vec3(max(0.25 * outline, grey * water.a * inside));
+  vec2 wiper = wiper_coverage(mm, px);
+  colour = mix(colour, vec3(0.05, 0.12, 0.45), wiper.y);
+  colour = mix(colour, vec3(0.15, 0.35, 1.0), wiper.x);
+  out_colour = vec4(colour, 1.0);
 }

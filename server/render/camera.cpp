@@ -20,6 +20,8 @@ sim::CameraPose default_camera_pose(sim::View view) {
 
 double default_fov_deg(sim::View view) { return view == sim::View::kRoad ? 55.0 : 60.0; }
 
+sim::CameraPose dash_camera_pose() { return {{1.52, 0.0, 1.21}, {0.0, 3.0, 0.0}}; }
+
 Camera make_camera(const sim::ViewSpec& spec, const sim::VehicleState& vehicle) {
   const sim::CameraPose pose = spec.camera ? *spec.camera : default_camera_pose(spec.view);
   // Camera frame in the vehicle frame, then GL's camera axes (x right, y up, looking down -z).
@@ -32,6 +34,8 @@ Camera make_camera(const sim::ViewSpec& spec, const sim::VehicleState& vehicle) 
   Camera c;
   c.fov_y_deg = static_cast<float>(spec.fov_deg > 0.0 ? spec.fov_deg : default_fov_deg(spec.view));
   c.position = glm::vec3(cam_to_world[3]);
+  // A camera in the cabin may sit a few centimetres from the raked glass.
+  if (spec.view == sim::View::kCockpit) c.near_m = 0.01f;
   c.view = glm::mat4(glm::inverse(cam_to_world));
   // Reversed-Z with an infinite far plane (clip control zero-to-one, depth test GREATER, clear 0):
   // float depth keeps its precision from the dashboard at 0.3 m to hills kilometres away.

@@ -17,6 +17,10 @@ struct FrameContext {
   Camera camera;
   Atmosphere atmosphere;
   glm::mat4 vehicle_to_world{1.0f};
+  // The view's render target, bound while the passes draw: its framebuffer and attachments.
+  GLuint target_fbo = 0;
+  GLuint target_colour = 0;
+  GLuint target_depth = 0;
 };
 
 // Texture units and the uniform block binding fixed across the shaders (common.glsl).
@@ -24,6 +28,12 @@ namespace binding {
 inline constexpr GLuint kFrameBlock = 0;
 inline constexpr GLuint kNoise = 1;
 inline constexpr GLuint kAsphalt = 2;
+inline constexpr GLuint kMetaballDensity = 3;
+inline constexpr GLuint kWaterHeights = 4;
+inline constexpr GLuint kWaterMap = 5;
+inline constexpr GLuint kSceneBlur = 6;
+inline constexpr GLuint kViewColour = 7;
+inline constexpr GLuint kViewDepth = 8;
 }  // namespace binding
 
 // Resources made once and shared by the passes.

@@ -13,7 +13,9 @@
 #include "server/render/passes/sky_pass.hpp"
 #include "server/render/passes/terrain_pass.hpp"
 #include "server/render/passes/vehicle_pass.hpp"
+#include "server/render/passes/windshield_glass_pass.hpp"
 #include "server/render/passes/windshield_pass.hpp"
+#include "server/render/passes/windshield_water_pass.hpp"
 #include "server/render/procedural_textures.hpp"
 #include "server/sim/pose.hpp"
 
@@ -91,6 +93,8 @@ struct Renderer::Impl {
   std::unique_ptr<RoadPass> road;
   std::unique_ptr<VehiclePass> vehicles;
   std::unique_ptr<CockpitPass> cockpit;
+  std::unique_ptr<WindshieldWaterPass> windshield_water;
+  std::unique_ptr<WindshieldGlassPass> windshield_glass;
   std::unique_ptr<WindshieldPass> windshield;
   std::map<std::uint64_t, std::unique_ptr<ViewTarget>> targets;
   // A fence per target slot still being read back: a slot is reused only after finish().
@@ -127,6 +131,15 @@ struct Renderer::Impl {
     glNamedBufferSubData(frame_ubo.id(), 0, sizeof(b), &b);
   }
 
+  // The water maps in glass space for this view's size, then back to the view's target.
+  void draw_windshield_water(const FrameContext& f) {
+    const WaterMapLayout layout = water_map_layout(f, windshield_water->config());
+    timed("windshield_splat", [&] { windshield_water->splat(f.scene.windshield, layout); });
+    timed("windshield_compress", [&] { windshield_water->compress(); });
+    glBindFramebuffer(GL_FRAMEBUFFER, f.target_fbo);
+    glViewport(0, 0, f.spec.width, f.spec.height);
+  }
+
   void draw_view(const FrameContext& f) {
     switch (f.spec.view) {
       case sim::View::kCockpit:
@@ -139,9 +152,15 @@ struct Renderer::Impl {
         timed("road", [&] { road->draw(f); });
         timed("terrain", [&] { terrain->draw(f); });
         timed("sky", [&] { sky->draw(f); });
+        if (f.spec.view == sim::View::kCockpit) {
+          timed("windshield_scene_copy", [&] { windshield_glass->copy_scene(f); });
+          draw_windshield_water(f);
+          timed("windshield_glass", [&] { windshield_glass->draw(f, *windshield_water); });
+        }
         break;
       case sim::View::kWindshield:
-        timed("windshield", [&] { windshield->draw(f); });
+        draw_windshield_water(f);
+        timed("windshield", [&] { windshield->draw(f, *windshield_water); });
         break;
       case sim::View::kRain:
         break;  // the rain layer over black: streaks and spray come with their passes
@@ -180,6 +199,8 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   impl->road = std::make_unique<RoadPass>(s);
   impl->vehicles = std::make_unique<VehiclePass>(s);
   impl->cockpit = std::make_unique<CockpitPass>(s);
+  impl->windshield_water = std::make_unique<WindshieldWaterPass>();
+  impl->windshield_glass = std::make_unique<WindshieldGlassPass>(s);
   impl->windshield = std::make_unique<WindshieldPass>(s);
   if (glGetError() != GL_NO_ERROR) throw std::runtime_error("GL error while creating the renderer");
   return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
@@ -207,8 +228,14 @@ PendingReadback Renderer::render(std::uint64_t key, const sim::ViewSpec& spec,
   if (m.in_flight.count({key, slot}))
     throw std::logic_error("readback slot reused before finish()");
 
-  FrameContext frame{scene, spec, make_camera(spec, scene.vehicle), atmosphere_from(scene.weather),
-                     glm::mat4(sim::vehicle_to_world(scene.vehicle))};
+  FrameContext frame{scene,
+                     spec,
+                     make_camera(spec, scene.vehicle),
+                     atmosphere_from(scene.weather),
+                     glm::mat4(sim::vehicle_to_world(scene.vehicle)),
+                     target->fbo.id(),
+                     target->colour.id(),
+                     target->depth.id()};
   glBindFramebuffer(GL_FRAMEBUFFER, target->fbo.id());
   glViewport(0, 0, spec.width, spec.height);
   const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};

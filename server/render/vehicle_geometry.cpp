@@ -60,13 +60,15 @@ MeshData build_cockpit_interior(const WindshieldCorners& g) {
       m.add_face(lo, lo + in, hi + in, hi, material::kTrim);
     }
   }
-  // Roof liner from the glass's top edge back over the driver.
-  m.add_face({g.top_right.x + 0.02f, -0.9f, g.top_right.z},
-             {g.top_left.x + 0.02f, 0.9f, g.top_left.z}, {0.2f, 0.9f, g.top_left.z + 0.06f},
+  // Roof liner from just inside the glass's top edge back over the driver: it hides the edge, so
+  // that the water drawn on the glass stops where the liner begins.
+  m.add_face({g.top_right.x - 0.03f, -0.9f, g.top_right.z - 0.01f},
+             {g.top_left.x - 0.03f, 0.9f, g.top_left.z - 0.01f}, {0.2f, 0.9f, g.top_left.z + 0.06f},
              {0.2f, -0.9f, g.top_right.z + 0.06f}, material::kTrim);
-  // Rear-view mirror on a short stem.
-  m.add_box({1.55f, -0.09f, 1.27f}, {1.57f, 0.09f, 1.32f}, material::kBody);
-  m.add_box({1.5f, -0.012f, 1.32f}, {1.52f, 0.012f, 1.37f}, material::kTrim);
+  // Rear-view mirror on a short stem up to the glass, inside it: the windshield pass draws the
+  // water over whatever lies beyond the glass.
+  m.add_box({1.50f, -0.09f, 1.22f}, {1.52f, 0.09f, 1.27f}, material::kBody);
+  m.add_box({1.47f, -0.012f, 1.27f}, {1.49f, 0.012f, 1.32f}, material::kTrim);
   return m;
 }
 

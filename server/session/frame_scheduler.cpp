@@ -5,6 +5,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "server/render/view_wet_fraction.hpp"
+
 namespace downpour::session {
 namespace {
 
@@ -62,6 +64,9 @@ struct FrameScheduler::InFlight {
   double sim_time_s = 0.0;
   double client_time_s = 0.0;
   double render_ms = 0.0;
+  std::uint32_t drops_on_glass = 0;
+  double glass_wet_fraction = 0.0;
+  double view_wet_fraction = 0.0;
   Clock::time_point inputs_arrived;
   bool from_earlier_loop = false;
 };
@@ -243,6 +248,9 @@ void FrameScheduler::tick(const std::shared_ptr<Session>& s, double dt_s, StepDo
     f.frame_number = frame_number;
     f.sim_time_s = scene.sim_time_s;
     f.client_time_s = scene.client_time_s;
+    f.drops_on_glass = scene.windshield.drops + scene.windshield.particles;
+    f.glass_wet_fraction = scene.windshield.glass_wet_fraction;
+    f.view_wet_fraction = render::view_wet_fraction(views[i], scene);
     f.inputs_arrived = inputs_arrived;
     in_flight_.push_back(std::move(f));
     ++frames_rendered_;
@@ -292,6 +300,9 @@ void FrameScheduler::collect(bool force_all) {
       frame->stats.readback_ms = readback_ms;
       frame->stats.encode_ms = encode_ms;
       frame->stats.latency_ms = ms_since(f.inputs_arrived);
+      frame->stats.drops_on_glass = f.drops_on_glass;
+      frame->stats.glass_wet_fraction = f.glass_wet_fraction;
+      frame->stats.view_wet_fraction = f.view_wet_fraction;
       ++frames_encoded_;
       {
         std::lock_guard lock(stats_mutex_);

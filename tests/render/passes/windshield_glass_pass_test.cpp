@@ -1,0 +1,199 @@
+// The COCKPIT view's windshield: water refracts the scene where it lies and nowhere else, the
+// cabin stays in front of the glass, the wiper blades show as dark strips, and a camera of its own
+// near the glass sees the drops out of focus.
+#include "server/render/passes/windshield_glass_pass.hpp"
+
+#include <cmath>
+#include <cstdlib>
+
+#include <gtest/gtest.h>
+
+#include "server/render/camera.hpp"
+#include "server/render/renderer.hpp"
+#include "server/sim/pose.hpp"
+#include "tests/render/windshield_fixture.hpp"
+#include "tests/support/png_io.hpp"
+
+namespace downpour::render {
+namespace {
+
+using testing::RgbaImage;
+
+constexpr int kWidth = 256;
+constexpr int kHeight = 144;
+
+class WindshieldGlassPassTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    renderer_ = Renderer::create({}).release();
+    scene_ = new sim::SceneState(testing::highway_scene());
+    scene_->windshield = sim::WindshieldState{};
+  }
+  static void TearDownTestSuite() {
+    delete renderer_;
+    delete scene_;
+    renderer_ = nullptr;
+  }
+
+  static sim::ViewSpec cockpit() { return {sim::View::kCockpit, kWidth, kHeight, 85, 0.0, {}}; }
+  static RgbaImage render(const sim::WindshieldState& water,
+                          const sim::ViewSpec& spec = cockpit()) {
+    sim::SceneState scene = *scene_;
+    scene.windshield = water;
+    return {spec.width, spec.height, render_image(*renderer_, spec, scene)};
+  }
+  // The pixel (x right, y down) where a glass point (mm) or a vehicle-frame point shows.
+  static glm::ivec2 pixel_of(const glm::dvec3& vehicle_point,
+                             const sim::ViewSpec& spec = cockpit()) {
+    const Camera camera = make_camera(spec, scene_->vehicle);
+    const glm::dvec4 clip = glm::dmat4(camera.projection * camera.view) *
+                            sim::vehicle_to_world(scene_->vehicle) * glm::dvec4(vehicle_point, 1.0);
+    const glm::dvec2 ndc = glm::dvec2(clip) / clip.w;
+    return {static_cast<int>((ndc.x * 0.5 + 0.5) * spec.width),
+            static_cast<int>((0.5 - ndc.y * 0.5) * spec.height)};
+  }
+  static glm::ivec2 glass_pixel(glm::dvec2 uv_mm) {
+    return pixel_of(scene_->glass.to_vehicle(uv_mm));
+  }
+
+  static double luma(const RgbaImage& image, glm::ivec2 p) {
+    return testing::mean_luma(image, p.x, p.y, p.x + 1, p.y + 1);
+  }
+  // Mean absolute difference over RGB in a pixel rectangle, in 0..255.
+  static double difference(const RgbaImage& a, const RgbaImage& b, int x0, int y0, int x1, int y1) {
+    double sum = 0.0;
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        for (int c = 0; c < 3; ++c) {
+          const std::size_t i = (static_cast<std::size_t>(y) * a.width + x) * 4 + c;
+          sum += std::abs(int(a.pixels[i]) - int(b.pixels[i]));
+        }
+      }
+    }
+    return sum / (3.0 * (x1 - x0) * (y1 - y0));
+  }
+
+  static void save_if_asked(const std::string& name, const RgbaImage& image) {
+    if (std::getenv("DOWNPOUR_SAVE_RENDERS"))
+      testing::write_png(::testing::TempDir() + name, image);
+  }
+
+  static Renderer* renderer_;
+  static sim::SceneState* scene_;
+};
+Renderer* WindshieldGlassPassTest::renderer_ = nullptr;
+sim::SceneState* WindshieldGlassPassTest::scene_ = nullptr;
+
+// Drops of 2.5 mm radius every 7 mm over a square of glass.
+sim::WindshieldState drop_patch(glm::dvec2 centre_mm, double half_mm) {
+  sim::WindshieldState s;
+  for (double u = centre_mm.x - half_mm; u <= centre_mm.x + half_mm; u += 7.0) {
+    for (double v = centre_mm.y - half_mm; v <= centre_mm.y + half_mm; v += 7.0) {
+      s.metaballs.push_back({static_cast<float>(u), static_cast<float>(v), 2.5f});
+    }
+  }
+  return s;
+}
+
+TEST_F(WindshieldGlassPassTest, DropsRefractWhereTheyLieAndNowhereElse) {
+  const RgbaImage clear = render({});
+  const glm::dvec2 centre(560.0, 420.0);
+  const RgbaImage wet = render(drop_patch(centre, 60.0));
+  save_if_asked("cockpit_drop_patch.png", wet);
+  // The patch's pixels, from two opposite corners (the glass is raked: take the box).
+  const glm::ivec2 a = glass_pixel(centre - 55.0), b = glass_pixel(centre + 55.0);
+  const int x0 = std::min(a.x, b.x), x1 = std::max(a.x, b.x), y0 = std::min(a.y, b.y),
+            y1 = std::max(a.y, b.y);
+  ASSERT_GT(x1 - x0, 8);
+  ASSERT_GT(y1 - y0, 4);
+  EXPECT_GT(difference(wet, clear, x0, y0, x1, y1), 4.0);
+  // Away from the patch the image is the clear one.
+  EXPECT_EQ(difference(wet, clear, 0, 0, kWidth, y0 - 8), 0.0);
+  EXPECT_EQ(difference(wet, clear, x1 + 12, 0, kWidth, kHeight), 0.0);
+}
+
+TEST_F(WindshieldGlassPassTest, ClearGlassLeavesTheScene) {
+  const RgbaImage nothing = render({});
+  sim::WindshieldState parked;
+  parked.blades = testing::parked_blades();
+  const RgbaImage clear = render(parked);
+  // Parked blades lie along (or below) the glass's bottom edge: the rest is untouched.
+  const int bottom = glass_pixel({760.0, 60.0}).y;
+  ASSERT_GT(bottom, kHeight / 2);
+  EXPECT_EQ(difference(clear, nothing, 0, 0, kWidth, bottom), 0.0);
+  EXPECT_GT(testing::psnr(clear, nothing), 40.0);
+}
+
+TEST_F(WindshieldGlassPassTest, TheCabinStaysInFrontOfTheWater) {
+  // Water over the whole glass.
+  sim::WindshieldState flooded;
+  for (double u = 4.0; u < 1520.0; u += 8.0) {
+    for (double v = 4.0; v < 762.0; v += 8.0) {
+      flooded.metaballs.push_back({static_cast<float>(u), static_cast<float>(v), 6.0f});
+    }
+  }
+  const RgbaImage clear = render({});
+  const RgbaImage wet = render(flooded);
+  save_if_asked("cockpit_flooded.png", wet);
+  // The mirror's face, in front of the glass: dark and unchanged.
+  const glm::ivec2 mirror = pixel_of({1.50, 0.0, 1.245});
+  ASSERT_LT(luma(clear, mirror), 0.15);
+  EXPECT_EQ(difference(wet, clear, mirror.x - 1, mirror.y - 1, mirror.x + 2, mirror.y + 2), 0.0);
+  // The dashboard below the glass: unchanged. The glass itself: changed nearly everywhere.
+  EXPECT_EQ(difference(wet, clear, 0, kHeight * 9 / 10, kWidth, kHeight), 0.0);
+  const glm::ivec2 middle = glass_pixel({760.0, 450.0});
+  EXPECT_GT(difference(wet, clear, middle.x - 20, middle.y - 10, middle.x + 20, middle.y + 10),
+            3.0);
+}
+
+TEST_F(WindshieldGlassPassTest, WiperBladesAreDarkStrips) {
+  sim::WindshieldState wiping;
+  wiping.blades = {testing::blade_at(0, 60.0), testing::blade_at(1, 50.0)};
+  const RgbaImage clear = render({});
+  const RgbaImage wiped = render(wiping);
+  save_if_asked("cockpit_blades.png", wiped);
+  int checked = 0;
+  for (const sim::BladePose& blade : wiping.blades) {
+    const glm::dvec2 dir(std::cos(blade.angle_rad), std::sin(blade.angle_rad));
+    for (double along : {0.5, 0.7, 0.9}) {
+      const glm::dvec2 uv = glm::dvec2(blade.pivot_mm) + along * blade.length_mm * dir;
+      if (!scene_->glass.contains(uv)) continue;
+      const glm::ivec2 p = glass_pixel(uv);
+      if (p.x < 0 || p.x >= kWidth || p.y < 0 || p.y >= kHeight) continue;
+      // Near black, blended at 256 x 144 with what lies around the strip.
+      EXPECT_LT(luma(wiped, p), 0.15) << "blade pixel " << p.x << ", " << p.y;
+      EXPECT_LT(luma(wiped, p), 0.5 * luma(clear, p)) << "blade pixel " << p.x << ", " << p.y;
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 4);
+}
+
+TEST_F(WindshieldGlassPassTest, ADashCameraSeesTheDropsOutOfFocus) {
+  const WindshieldGlassConfig config;
+  const sim::GlassConfig& glass = scene_->glass;
+  sim::ViewSpec dash = cockpit();
+  dash.camera = dash_camera_pose();
+  EXPECT_EQ(camera_defocus_mm(cockpit(), glass, config), 0.0);  // the driver's eye: in focus
+  const double at_dash = camera_defocus_mm(dash, glass, config);
+  EXPECT_GT(at_dash, 0.0);
+  // Nearer the glass, a larger blur.
+  sim::ViewSpec nearer = dash;
+  nearer.camera->position_m.x += 0.05;
+  sim::ViewSpec farther = dash;
+  farther.camera->position_m.x -= 0.3;
+  EXPECT_GT(camera_defocus_mm(nearer, glass, config), at_dash);
+  EXPECT_LT(camera_defocus_mm(farther, glass, config), at_dash);
+
+  // The dash camera's view is its own, and its drops change the image.
+  const sim::WindshieldState water = testing::rainy_windshield(glass, 3000);
+  const RgbaImage driver = render(water);
+  const RgbaImage dash_clear = render({}, dash);
+  const RgbaImage dash_wet = render(water, dash);
+  save_if_asked("cockpit_dash.png", dash_wet);
+  EXPECT_LT(testing::psnr(dash_wet, driver), 20.0);
+  EXPECT_GT(difference(dash_wet, dash_clear, 0, 0, kWidth, kHeight), 0.2);
+}
+
+}  // namespace
+}  // namespace downpour::render

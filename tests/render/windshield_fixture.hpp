@@ -1,0 +1,226 @@
+// Hand-made windshield water for the render tests and the render-views tool: deterministic states
+// built without the simulation (drops, trails, wiped sectors, water piled at the blades), and the
+// coverage grid that the simulation would publish with them.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <numbers>
+#include <utility>
+
+#include "server/sim/scenario.hpp"
+#include "server/sim/simulation.hpp"
+#include "server/sim/windshield.hpp"
+
+namespace downpour::testing {
+
+// The render tests' scene: the highway 10 s in, on the straight, heavy rain; the windshield as the
+// simulation left it (replace it for tests about the water). Simulated once per weather and kept:
+// ten seconds of water on the glass take a while.
+inline sim::SceneState highway_scene(double rain_mm_h = 25.0, double cloudiness = 0.95) {
+  static std::map<std::pair<double, double>, sim::SceneState> simulated;
+  const auto it = simulated.find({rain_mm_h, cloudiness});
+  if (it != simulated.end()) return it->second;
+  const sim::Scenario scenario = sim::highway_heavy_rain();
+  sim::Update update = scenario.at(10.0);
+  update.weather->rain_rate_mm_h = rain_mm_h;
+  update.weather->cloudiness = cloudiness;
+  sim::Simulation simulation(scenario.seed, update);
+  simulation.advance(10.0);
+  return simulated.emplace(std::pair(rain_mm_h, cloudiness), simulation.state()).first->second;
+}
+
+// A small deterministic generator (splitmix64): the same pictures on every standard library.
+class FixtureRandom {
+ public:
+  explicit FixtureRandom(std::uint64_t seed) : state_(seed) {}
+  std::uint64_t next() {
+    std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+  }
+  double uniform(double lo = 0.0, double hi = 1.0) {
+    return lo + (hi - lo) * static_cast<double>(next() >> 11) * 0x1.0p-53;
+  }
+
+ private:
+  std::uint64_t state_;
+};
+
+// A blade of the default wipers (sim::WiperConfig) at an angle from +u, degrees.
+inline sim::BladePose blade_at(int index, double angle_deg) {
+  const sim::BladeConfig c = sim::WiperConfig{}.blades[index];
+  sim::BladePose b;
+  b.pivot_mm = glm::vec2(c.pivot_mm);
+  b.angle_rad = static_cast<float>(angle_deg * std::numbers::pi / 180.0);
+  b.length_mm = static_cast<float>(c.length_mm);
+  b.width_mm = static_cast<float>(c.width_mm);
+  return b;
+}
+
+inline std::array<sim::BladePose, 2> parked_blades() {
+  const sim::WiperConfig w;
+  return {blade_at(0, w.blades[0].park_deg), blade_at(1, w.blades[1].park_deg)};
+}
+
+// The coverage grid from the metaballs: the wet fraction of each cell (0..255) from 2 x 2 samples,
+// wet where the summed density exceeds 0.5 (the compressed density exceeds 0.5 exactly where the
+// raw one does).
+inline void fill_coverage(sim::WindshieldState& state, const sim::GlassConfig& glass) {
+  const double cell = state.coverage_cell_mm;
+  state.coverage_width = static_cast<int>(std::ceil(glass.bottom_width_mm / cell));
+  state.coverage_height = static_cast<int>(std::ceil(glass.height_mm / cell));
+  // Densities at 2 x 2 samples a cell, at quarter offsets.
+  const int sw = 2 * state.coverage_width, sh = 2 * state.coverage_height;
+  const double step = 0.5 * cell;
+  std::vector<float> density(static_cast<std::size_t>(sw) * sh);
+  for (const sim::Metaball& m : state.metaballs) {
+    const double reach = 2.5 * m.radius_mm;
+    const int x0 = std::max(0, static_cast<int>(std::floor((m.u_mm - reach) / step)));
+    const int x1 = std::min(sw - 1, static_cast<int>((m.u_mm + reach) / step));
+    const int y0 = std::max(0, static_cast<int>(std::floor((m.v_mm - reach) / step)));
+    const int y1 = std::min(sh - 1, static_cast<int>((m.v_mm + reach) / step));
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) {
+        const double du = (x + 0.5) * step - m.u_mm, dv = (y + 0.5) * step - m.v_mm;
+        const double q = (du * du + dv * dv) / (double(m.radius_mm) * m.radius_mm);
+        density[static_cast<std::size_t>(y) * sw + x] += static_cast<float>(1.0 / (1.0 + q * q));
+      }
+    }
+  }
+  state.coverage.assign(static_cast<std::size_t>(state.coverage_width) * state.coverage_height, 0);
+  double wet = 0.0;
+  int on_glass = 0;
+  for (int y = 0; y < state.coverage_height; ++y) {
+    for (int x = 0; x < state.coverage_width; ++x) {
+      int samples = 0;
+      for (int j = 0; j < 2; ++j) {
+        for (int i = 0; i < 2; ++i) {
+          samples += density[static_cast<std::size_t>(2 * y + j) * sw + 2 * x + i] > 0.5f;
+        }
+      }
+      const std::size_t c = static_cast<std::size_t>(y) * state.coverage_width + x;
+      state.coverage[c] = static_cast<std::uint8_t>(std::lround(samples * 255.0 / 4.0));
+      if (glass.contains({(x + 0.5) * cell, (y + 0.5) * cell})) {
+        ++on_glass;
+        wet += state.coverage[c] / 255.0;
+      }
+    }
+  }
+  state.glass_wet_fraction = on_glass ? wet / on_glass : 0.0;
+}
+
+// Rain on the glass with the wipers part-way up their sweep: drops of many sizes (a main metaball,
+// some with sub-metaballs that make the outline irregular), a few running drops with trails above
+// them, the blades' swept sectors clear but for fresh small drops, and water piled along the
+// blades' leading edges (particles). About `metaballs` metaballs in all.
+inline sim::WindshieldState rainy_windshield(const sim::GlassConfig& glass, int metaballs,
+                                             std::array<double, 2> blade_deg = {40.0, 36.0},
+                                             std::uint64_t seed = 7) {
+  FixtureRandom rng(seed);
+  sim::WindshieldState s;
+  const sim::WiperConfig wipers;
+  for (int i = 0; i < 2; ++i) s.blades[i] = blade_at(i, blade_deg[i]);
+  const auto add = [&](double u, double v, double r) {
+    if (glass.contains({u, v}))
+      s.metaballs.push_back({static_cast<float>(u), static_cast<float>(v), static_cast<float>(r)});
+  };
+  // In a blade's swept sector (from park up to its angle now).
+  const auto wiped = [&](double u, double v) {
+    for (int i = 0; i < 2; ++i) {
+      const sim::BladeConfig& c = wipers.blades[i];
+      const double du = u - c.pivot_mm.x, dv = v - c.pivot_mm.y;
+      const double angle = std::atan2(dv, du) * 180.0 / std::numbers::pi;
+      if (std::hypot(du, dv) < c.length_mm && angle > c.park_deg - 2.0 && angle < blade_deg[i])
+        return true;
+    }
+    return false;
+  };
+  // Water pushed by each blade: particles in rows along its leading (upper) edge.
+  const int particle_budget = metaballs / 6;
+  const double particle_r = sim::WaterConfig{}.particle_radius_mm;
+  for (int i = 0; i < 2; ++i) {
+    const sim::BladePose& b = s.blades[i];
+    const glm::dvec2 dir(std::cos(b.angle_rad), std::sin(b.angle_rad));
+    const glm::dvec2 side(-dir.y, dir.x);
+    for (int k = 0; k < particle_budget / 2; ++k) {
+      const double along = rng.uniform(0.15, 1.0) * b.length_mm;
+      const double across =
+          0.5 * b.width_mm + particle_r * (1.0 + 2.0 * std::floor(rng.uniform(0, 3)));
+      const glm::dvec2 p = glm::dvec2(b.pivot_mm) + along * dir + across * side;
+      add(p.x, p.y, particle_r);
+    }
+  }
+  const std::size_t particles = s.metaballs.size();
+  // Running drops with trails of small drops above them.
+  for (int k = 0; k < 12; ++k) {
+    const double u = rng.uniform(60.0, glass.bottom_width_mm - 60.0);
+    const double v = rng.uniform(80.0, glass.height_mm - 150.0);
+    if (wiped(u, v)) continue;
+    const double r = rng.uniform(2.3, 3.2);
+    add(u, v, r);
+    add(u + 0.6 * r, v + 0.3 * r, 0.6 * r);
+    double tu = u;
+    for (double tv = v + r; tv < v + rng.uniform(40.0, 140.0); tv += 1.6) {
+      tu += rng.uniform(-0.5, 0.5);
+      add(tu, tv, rng.uniform(0.5, 0.9));
+    }
+  }
+  // Drops: mostly small, a few large; in the swept sectors only fresh small ones.
+  while (static_cast<int>(s.metaballs.size()) < metaballs) {
+    const double u = rng.uniform(0.0, glass.bottom_width_mm);
+    const double v = rng.uniform(0.0, glass.height_mm);
+    const double size = rng.uniform();
+    double r = 0.5 + 1.4 * size * size * size + rng.uniform(0.0, 0.3);
+    if (wiped(u, v)) {
+      if (rng.uniform() > 0.15) continue;
+      r = std::min(r, 0.8);
+    }
+    add(u, v, r);
+    if (r > 1.0 && rng.uniform() < 0.6) {
+      const int subs = 1 + static_cast<int>(rng.uniform(0.0, 3.0));
+      for (int j = 0; j < subs; ++j) {
+        const double a = rng.uniform(0.0, 2.0 * std::numbers::pi);
+        const double d = rng.uniform(0.5, 0.9) * r;
+        add(u + d * std::cos(a), v + d * std::sin(a), rng.uniform(0.4, 0.6) * r);
+      }
+    }
+  }
+  s.metaballs.resize(std::min<std::size_t>(s.metaballs.size(), metaballs));
+  s.particles = static_cast<std::uint32_t>(std::min(particles, s.metaballs.size()));
+  s.drops = static_cast<std::uint32_t>(s.metaballs.size()) - s.particles;
+  fill_coverage(s, glass);
+  return s;
+}
+
+// A splash: a patch of water about `radius_mm` across, made of a ring of metaballs around one.
+inline void add_splash(sim::WindshieldState& state, double u, double v, double radius_mm) {
+  const float r = static_cast<float>(0.45 * radius_mm);
+  state.metaballs.push_back({static_cast<float>(u), static_cast<float>(v), r});
+  for (int k = 0; k < 6; ++k) {
+    const double a = k * std::numbers::pi / 3.0 + 0.3;
+    state.metaballs.push_back({static_cast<float>(u + 0.55 * radius_mm * std::cos(a)),
+                               static_cast<float>(v + 0.55 * radius_mm * std::sin(a)),
+                               static_cast<float>(r * (0.8 + 0.05 * k))});
+  }
+}
+
+// The golden images' windshield: rain of about 1500 metaballs with the blades part-way up, a few
+// large splashes (to be seen at 256 x 144) and a row of single drops of growing size.
+inline sim::WindshieldState golden_windshield(const sim::GlassConfig& glass) {
+  sim::WindshieldState s = rainy_windshield(glass, 1500, {55.0, 48.0}, 11);
+  add_splash(s, 420.0, 560.0, 40.0);
+  add_splash(s, 1150.0, 620.0, 28.0);
+  add_splash(s, 760.0, 690.0, 22.0);
+  for (int k = 0; k < 6; ++k) {
+    s.metaballs.push_back({static_cast<float>(200.0 + 130.0 * k), 300.0f, 1.0f + 1.2f * k});
+  }
+  fill_coverage(s, glass);
+  return s;
+}
+
+}  // namespace downpour::testing
