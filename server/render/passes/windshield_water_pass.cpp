@@ -108,21 +108,19 @@ WindshieldWaterPass::WindshieldWaterPass(WindshieldWaterConfig config)
   glTextureParameteri(density_.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   glTextureParameteri(density_.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
 
-  GLuint vao = 0, buffer = 0;
-  glCreateVertexArrays(1, &vao);
-  metaball_vao_ = VertexArray(vao);
-  glCreateBuffers(1, &buffer);
-  metaball_buffer_ = Buffer(buffer);
-  glEnableVertexArrayAttrib(vao, 0);
-  glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribBinding(vao, 0, 0);
-  glCreateVertexArrays(1, &vao);
-  tile_vao_ = VertexArray(vao);
-  glCreateBuffers(1, &buffer);
-  tile_buffer_ = Buffer(buffer);
-  glEnableVertexArrayAttrib(vao, 0);
-  glVertexArrayAttribFormat(vao, 0, 2, GL_FLOAT, GL_FALSE, 0);
-  glVertexArrayAttribBinding(vao, 0, 0);
+  // One float attribute stream each: metaballs (u, v, R) and compression tiles (u, v).
+  auto point_stream = [](int components, VertexArray& vao_out, Buffer& buffer_out) {
+    GLuint vao = 0, buffer = 0;
+    glCreateVertexArrays(1, &vao);
+    vao_out = VertexArray(vao);
+    glCreateBuffers(1, &buffer);
+    buffer_out = Buffer(buffer);
+    glEnableVertexArrayAttrib(vao, 0);
+    glVertexArrayAttribFormat(vao, 0, components, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(vao, 0, 0);
+  };
+  point_stream(3, metaball_vao_, metaball_buffer_);
+  point_stream(2, tile_vao_, tile_buffer_);
 
   const HeightCompressionConfig& c = config_.compression;
   for (ShaderProgram* p : {&compress_program_, &compress_tiles_program_}) {
