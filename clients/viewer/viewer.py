@@ -24,6 +24,7 @@ import grpc  # noqa: E402
 from downpour_client import DownpourClient, enum_name  # noqa: E402
 from downpour.v1 import downpour_pb2 as pb  # noqa: E402
 
+MIN_RATE_SPAN_S = 0.5
 FPS_WINDOW_S = 2.0
 RETRY_S = 0.5
 BOUNDARY = "downpour-frame"
@@ -111,8 +112,9 @@ class LatestFrames:
 
 
 def _rate(arrivals):
-    """Frames per second over the arrival times kept."""
-    if len(arrivals) < 2 or arrivals[-1] <= arrivals[0]:
+    """Frames per second over the arrival times kept; 0 until they span half a second, so a
+    burst of a few frames after a stall does not read as a huge rate."""
+    if len(arrivals) < 2 or arrivals[-1] - arrivals[0] < MIN_RATE_SPAN_S:
         return 0.0
     return (len(arrivals) - 1) / (arrivals[-1] - arrivals[0])
 

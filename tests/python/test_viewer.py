@@ -46,6 +46,7 @@ class ViewerTest(unittest.TestCase):
 
     def wait_for(self, condition, timeout_s=10.0):
         deadline = time.monotonic() + timeout_s
+        status = None
         while time.monotonic() < deadline:
             status = self.status()
             if condition(status):
