@@ -88,7 +88,7 @@ double WaterSim::mass_on_glass() const {
     if (d.alive) m += d.mass;
   }
   for (const Particle& p : particles_) m += p.mass;
-  return m;
+  return m + carried_[0] + carried_[1];
 }
 
 void WaterSim::set_mass(Drop& d, double mass) {
@@ -265,14 +265,17 @@ void WaterSim::move_drops(double dt, const WaterInputs& in) {
     if (!d.alive) continue;
     if (d.subs > 0 && (d.sub_age += dt) >= w.sub_metaball_merge_s) d.subs = 0;
     if (d.trail) {
+      // Evaporation through the drop's surface: the radius shrinks at a steady rate.
       d.age += dt;
-      const double mass = d.trail_mass0 * (1.0 - d.age / w.trail_lifetime_s);
-      if (mass <= 0.0) {
+      const double left = 1.0 - d.age / w.trail_lifetime_s;
+      if (left <= 0.0) {
         ledger_.evaporated += d.mass;
         remove_drop(static_cast<int>(i));
       } else {
+        const double mass = d.trail_mass0 * left * left * left;
         ledger_.evaporated += d.mass - mass;
-        set_mass(d, mass);
+        d.mass = mass;
+        d.radius = d.trail_radius0 * left;
       }
       continue;
     }
@@ -337,6 +340,7 @@ void WaterSim::move_drop(int i, double dt) {
       const int t = new_drop(from, trail);  // may reallocate drops_
       drops_[t].trail = true;
       drops_[t].trail_mass0 = trail;
+      drops_[t].trail_radius0 = drops_[t].radius;
     }
     if (!on_glass(to)) {
       ledger_.drained += drops_[i].mass;
@@ -407,86 +411,100 @@ void WaterSim::sweep_blades(const WaterInputs& in) {
           !swept(d.pos, d.radius, &along)) {
         continue;
       }
+      // Particles are equal: the drop's water joins what the blade already carries, and whole
+      // particles' worth of it come off as particles here (a tiny trail drop alone makes none).
       const double mass = d.mass;
-      const int count = std::max(1, static_cast<int>(std::ceil(mass / particle_mass_ - 1e-9)));
       remove_drop(static_cast<int>(i));
-      if (particles_.size() + count > w.max_particles) {
+      if (particles_.size() >= w.max_particles) {
         ledger_.wiped_off += mass;
         continue;
       }
+      carried_[b] += mass;
+      const int count = static_cast<int>(std::floor(carried_[b] / particle_mass_ + 1e-9));
+      carried_[b] = std::max(0.0, carried_[b] - count * particle_mass_);
       for (int k = 0; k < count; ++k) {
         // One at the drop, the rest jittered about it, all ahead of the blade; overlaps resolve
         // through repulsion.
         const double jitter_along = k == 0 ? 0.0 : blade_random_.uniform(-rp, rp);
         const double jitter_ahead = k == 0 ? 0.0 : blade_random_.uniform(0.0, 2.0 * rp);
         particles_.push_back({pivot + (along + jitter_along) * d1 + (half + rp + jitter_ahead) * n1,
-                              mass / count, 0.0});
+                              particle_mass_, 0.0});
       }
     }
   }
 }
 
 // Pairwise repulsion through a spatial hash: grid cells of one particle diameter, hashed into a
-// table about twice the particle count, so the cost follows the particles, not the glass.
+// table about twice the particle count, so the cost follows the particles, not the glass. Each
+// iteration works on float copies of the positions sorted by bucket (a counting sort, so the order
+// and the result are deterministic): a bucket's particles are one contiguous run.
 void WaterSim::repel_particles() {
   const WaterConfig& w = config_.water;
-  const double rp = w.particle_radius_mm, touch = 2.0 * rp;
-  const std::size_t count = particles_.size();
+  const float touch = static_cast<float>(2.0 * w.particle_radius_mm);
+  const float push = static_cast<float>(0.5 + w.penalty);  // half the overlap, plus the penalty
+  const std::uint32_t count = static_cast<std::uint32_t>(particles_.size());
   if (count < 2) return;
   std::uint32_t buckets = 64;
   while (buckets < 2 * count) buckets *= 2;
   const std::uint32_t mask = buckets - 1;
-  auto cell_of = [&](glm::dvec2 p) {
-    return glm::ivec2(static_cast<int>(std::floor(p.x / touch)),
-                      static_cast<int>(std::floor(p.y / touch)));
-  };
-  auto bucket_of = [&](glm::ivec2 c) {
-    return (static_cast<std::uint32_t>(c.x) * 73856093u ^
-            static_cast<std::uint32_t>(c.y) * 19349663u) &
+  const float inv_touch = 1.0f / touch;
+  auto bucket_of = [&](int cu, int cv) {
+    return (static_cast<std::uint32_t>(cu) * 73856093u ^
+            static_cast<std::uint32_t>(cv) * 19349663u) &
            mask;
   };
-  std::vector<std::uint32_t> fill;
+  hash_ids_.resize(count);
+  hash_pos_.resize(count);
+  hash_cell_.resize(count);
   for (int iteration = 0; iteration < kRepulsionIterations; ++iteration) {
-    // Counting sort into the buckets: ids in index order within each, so the result is
-    // deterministic.
     hash_start_.assign(buckets + 1, 0u);
-    for (const Particle& p : particles_) ++hash_start_[bucket_of(cell_of(p.pos)) + 1];
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const glm::dvec2 p = particles_[i].pos;
+      const glm::ivec2 c(static_cast<int>(std::floor(static_cast<float>(p.x) * inv_touch)),
+                         static_cast<int>(std::floor(static_cast<float>(p.y) * inv_touch)));
+      hash_cell_[i] = c;
+      ++hash_start_[bucket_of(c.x, c.y) + 1];
+    }
     for (std::uint32_t b = 1; b <= buckets; ++b) hash_start_[b] += hash_start_[b - 1];
-    hash_ids_.resize(count);
-    fill.assign(hash_start_.begin(), hash_start_.end() - 1);
-    for (std::uint32_t i = 0; i < count; ++i)
-      hash_ids_[fill[bucket_of(cell_of(particles_[i].pos))]++] = i;
+    hash_fill_.assign(hash_start_.begin(), hash_start_.end() - 1);
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const std::uint32_t slot = hash_fill_[bucket_of(hash_cell_[i].x, hash_cell_[i].y)]++;
+      hash_ids_[slot] = i;
+      hash_pos_[slot] = glm::vec2(particles_[i].pos);
+    }
 
     bool overlapped = false;
-    for (std::uint32_t i = 0; i < count; ++i) {
-      const glm::ivec2 c = cell_of(particles_[i].pos);
+    for (std::uint32_t a = 0; a < count; ++a) {
+      const glm::ivec2 c = hash_cell_[hash_ids_[a]];
       std::uint32_t seen[9];
       int seen_count = 0;
       for (int dv = -1; dv <= 1; ++dv) {
         for (int du = -1; du <= 1; ++du) {
-          const std::uint32_t b = bucket_of(c + glm::ivec2(du, dv));
+          const std::uint32_t b = bucket_of(c.x + du, c.y + dv);
           if (std::find(seen, seen + seen_count, b) != seen + seen_count) continue;  // a collision
           seen[seen_count++] = b;
-          for (std::uint32_t k = hash_start_[b]; k < hash_start_[b + 1]; ++k) {
-            const std::uint32_t j = hash_ids_[k];
-            if (j <= i) continue;
-            const glm::dvec2 delta = particles_[j].pos - particles_[i].pos;
-            const double dist2 = glm::dot(delta, delta);
+          for (std::uint32_t k = std::max(hash_start_[b], a + 1); k < hash_start_[b + 1]; ++k) {
+            const glm::vec2 delta = hash_pos_[k] - hash_pos_[a];
+            const float dist2 = glm::dot(delta, delta);
             if (dist2 >= touch * touch) continue;
-            const double dist = std::sqrt(dist2);
+            const float dist = std::sqrt(dist2);
             // Coincident particles part along a direction that depends only on their ids.
-            const glm::dvec2 dir =
-                dist > 1e-9 ? delta / dist
-                            : glm::dvec2(std::cos(i * 2.399 + j), std::sin(i * 2.399 + j));
-            // Apart by half the overlap each, and further by the overlap times the penalty.
-            const double overlap = touch - dist;
-            const double move = 0.5 * overlap + w.penalty * overlap;
-            particles_[i].pos -= move * dir;
-            particles_[j].pos += move * dir;
+            const float angle =
+                static_cast<float>(hash_ids_[a]) * 2.399f + static_cast<float>(hash_ids_[k]);
+            const glm::vec2 dir =
+                dist > 1e-6f ? delta / dist : glm::vec2(std::cos(angle), std::sin(angle));
+            const glm::vec2 move = (push * (touch - dist)) * dir;
+            hash_pos_[a] -= move;
+            hash_pos_[k] += move;
             overlapped = true;
           }
         }
       }
+    }
+    for (std::uint32_t a = 0; a < count; ++a) {
+      glm::dvec2& p = particles_[hash_ids_[a]].pos;
+      const glm::dvec2 moved(hash_pos_[a]);
+      if (moved != glm::dvec2(glm::vec2(p))) p = moved;  // untouched ones keep their precision
     }
     if (!overlapped) break;
   }

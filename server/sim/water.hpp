@@ -51,8 +51,9 @@ class WaterSim {
     bool moving = false;
     bool trail = false;
     double age = 0.0;          // trail drops: seconds since left behind
-    double trail_mass0 = 0.0;  // trail drops: mass when left behind
-    int subs = 0;              // impact sub-metaballs still merging
+    double trail_mass0 = 0.0;  // trail drops: mass and radius when left behind
+    double trail_radius0 = 0.0;
+    int subs = 0;  // impact sub-metaballs still merging
     double sub_age = 0.0;
     std::array<glm::vec2, 3> sub_dir{};  // their unit directions from the main metaball
     bool alive = false;
@@ -117,6 +118,9 @@ class WaterSim {
   std::uint32_t drop_count_ = 0;
   std::vector<Particle> particles_;
   double particle_mass_ = 0.0;
+  // Water each blade has gathered from drops but not yet a whole particle's worth, mg (counted
+  // as on the glass: it rides on the blade's edge).
+  std::array<double, 2> carried_{};
   double pin_per_mm_ = 0.0;  // pinning force per mm of radius, N/mm, from the critical radius
   glm::dvec2 gravity_{0.0};  // along the glass, m/s^2, in (u, v)
   glm::dvec2 air_{0.0};      // airflow along the glass at the drops, m/s, in (u, v)
@@ -124,8 +128,10 @@ class WaterSim {
   std::array<BladePose, 2> blades_{};  // as of the last step
   WaterLedger ledger_;
   // Particle neighbour hash: bucket start offsets and the ids sorted by bucket.
-  std::vector<std::uint32_t> hash_start_;
-  std::vector<std::uint32_t> hash_ids_;
+  std::vector<std::uint32_t> hash_start_, hash_fill_;
+  std::vector<std::uint32_t> hash_ids_;  // particle index, in bucket order
+  std::vector<glm::vec2> hash_pos_;      // its position, in bucket order
+  std::vector<glm::ivec2> hash_cell_;    // grid cell, in particle order
 };
 
 }  // namespace downpour::sim

@@ -71,7 +71,7 @@ struct WaterConfig {
   double max_speed_mm_s = 400.0;
   double trail_fraction = 0.01;       // of a moving drop's mass left behind per cell moved
   double trail_min_mass_mg = 0.02;    // smaller trail drops are not left
-  double trail_lifetime_s = 4.0;      // trail drops shrink linearly to nothing over this time
+  double trail_lifetime_s = 4.0;      // a trail drop's radius shrinks to nothing over this time
   double sub_metaball_merge_s = 0.6;  // impact sub-metaballs migrate into the main one over this
   int impact_sub_metaballs = 3;
   double sub_metaball_offset = 0.9;   // initial offset, in main radii
