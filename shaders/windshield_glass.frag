@@ -17,21 +17,27 @@ uniform vec2 u_map_extent_mm;
 uniform float u_water_lod;  // defocus of a close camera
 uniform vec2 u_inv_viewport;
 uniform vec4 u_screen_axes;  // screen directions of glass +u (xy) and +v (zw)
-uniform vec2 u_refraction;   // uv offset per unit of the normal's glass-parallel part
+uniform vec2 u_refraction;   // uv offset per unit of the deflection angle's tangent
+uniform float u_water_ior;
 uniform float u_background_lod;
 uniform float u_fresnel_r0;
 uniform float u_rim_darkening;
+uniform vec2 u_rim_lean;  // the lean where rims start to darken and where they are darkest
 
 void main() {
   vec4 water = textureLod(water_tex, (v_glass_mm - u_map_origin_mm) / u_map_extent_mm, u_water_lod);
   float wet = water.a;
   if (wet < 0.004) discard;
   vec2 n = water.xy * 2.0 - 1.0;  // glass-parallel part of the surface normal
-  vec2 offset = -(n.x * u_screen_axes.xy + n.y * u_screen_axes.zw) * u_refraction;
+  float steep = dot(n, n);
+  float lean = sqrt(steep);  // sine of the surface's tilt
+  float bend = asin(min(u_water_ior * lean, 1.0)) - asin(min(lean, 1.0));
+  vec2 towards = lean > 1e-4 ? n / lean : vec2(0.0);
+  vec2 offset = -(towards.x * u_screen_axes.xy + towards.y * u_screen_axes.zw) * tan(bend) *
+                u_refraction;
   vec3 behind =
       textureLod(scene_tex, gl_FragCoord.xy * u_inv_viewport + offset, u_background_lod).rgb;
-  float steep = dot(n, n);
-  behind *= 1.0 - u_rim_darkening * smoothstep(0.08, 0.4, steep);
+  behind *= 1.0 - u_rim_darkening * smoothstep(u_rim_lean.x, u_rim_lean.y, lean);
   vec3 tilt = n.x * u_glass_u + n.y * u_glass_v;
   vec3 normal = tilt + sqrt(max(1.0 - steep, 0.0)) * u_glass_n;
   vec3 view = normalize(v_world - frame.camera_pos.xyz);

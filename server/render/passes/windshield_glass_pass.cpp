@@ -53,6 +53,8 @@ WindshieldGlassPass::WindshieldGlassPass(SharedResources& shared, WindshieldGlas
   program_.set("u_background_lod", config_.background_lod);
   program_.set("u_fresnel_r0", config_.fresnel_r0);
   program_.set("u_rim_darkening", config_.rim_darkening);
+  program_.set("u_rim_lean", glm::vec2(config_.rim_lean[0], config_.rim_lean[1]));
+  program_.set("u_water_ior", config_.water_ior);
 }
 
 WindshieldGlassPass::SceneCopy& WindshieldGlassPass::scene_copy_for(int view_width,
@@ -149,11 +151,11 @@ void WindshieldGlassPass::draw(const FrameContext& frame, WindshieldWaterPass& w
   program_.set("u_map_extent_mm", layout.extent_mm);
   program_.set("u_water_lod", water_lod);
   program_.set("u_inv_viewport", 1.0f / glm::vec2(width, height));
-  // Screen offset of the lookup per unit of the normal's glass-parallel part: the deflection angle
-  // times the focal length, in uv units of the view (the image's size and field of view).
+  // Screen offset of the lookup per unit of the deflection angle's tangent: the focal length in
+  // uv units of the view (the image's size and field of view).
   const float focal = frame.camera.projection[1][1];
   const float aspect = static_cast<float>(width) / static_cast<float>(height);
-  program_.set("u_refraction", config_.deflection * 0.5f * glm::vec2(focal / aspect, focal));
+  program_.set("u_refraction", 0.5f * glm::vec2(focal / aspect, focal));
   program_.set("u_screen_axes", glm::vec4(screen_direction(frame, glass.u_axis()),
                                           screen_direction(frame, glass.v_axis())));
   glBindTextureUnit(binding::kWaterMap, water.water_map());

@@ -11,12 +11,16 @@ struct WindshieldGlassConfig {
   // The refraction background (seed 000, section 1.5 step 5): the scene copied at a quarter of the
   // view's size and mipmapped; drops sample it at background_lod (the paper used a 64 x 64 copy).
   float background_lod = 1.0f;
-  // Deflection of a view ray (radians) per unit of the water normal's glass-parallel part: about
-  // n_water - 1 for a thin prism. Times the focal length gives the lookup's screen offset.
-  float deflection = 0.33f;
+  // A view ray leaving the water through a surface tilted by a (sin a = the normal's
+  // glass-parallel part) turns by asin(n sin a) - a towards the glass's own normal side (a drop
+  // is a converging lens: the world shows turned over); the tangent of that angle times the
+  // focal length gives the lookup's screen offset.
+  float water_ior = 1.33f;
   float fresnel_r0 = 0.02f;  // water
-  // Steep drop rims reflect the dark cabin (total internal reflection): darker by this much.
-  float rim_darkening = 0.65f;
+  // Drop rims: where the surface leans more than rim_lean[0] (up to rim_lean[1]) the rays bend so
+  // far that they see the dark cabin and the car's body: darker by this much.
+  float rim_darkening = 0.55f;
+  float rim_lean[2] = {0.45f, 0.62f};
   // A camera of its own (ViewSpec::camera) is a lens focused beyond the glass: drops on the glass
   // blur over a circle of aperture * (1 - distance / focus) mm (thin lens). The driver's eye is
   // drawn in focus.

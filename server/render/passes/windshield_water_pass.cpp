@@ -131,7 +131,6 @@ WindshieldWaterPass::WindshieldWaterPass(WindshieldWaterConfig config)
     p->set("u_threshold", c.threshold);
     p->set("u_height_scale_mm", config_.height_scale_mm);
     p->set("u_contact_sin", std::sin(glm::radians(config_.contact_angle_deg)));
-    p->set("u_meniscus_mm", config_.meniscus_mm);
   }
   for (ShaderProgram* p : {&splat_program_, &compress_program_})
     p->set("u_extent_radii", config_.splat_extent_radii);

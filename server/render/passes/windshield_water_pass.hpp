@@ -37,11 +37,10 @@ struct WindshieldWaterConfig {
   // Around the part of the glass that a COCKPIT view sees: metaballs whose sprite reaches into
   // it have their centre within the margin (sprites are culled by their centre).
   float map_margin_mm = 30.0f;
-  // Beyond the paper: the water height (mm) of a compressed density of 1, for the normals, and a
-  // meniscus at the water's edge: the surface leans at least at the contact angle there.
+  // Beyond the paper: the water height (mm) of a compressed density of 1, for the normals, and
+  // lenses: a lone drop is a spherical cap meeting the glass at the contact angle.
   float height_scale_mm = 4.0f;
   float contact_angle_deg = 40.0f;
-  float meniscus_mm = 2.0f;
 };
 
 struct WaterMapSize {
