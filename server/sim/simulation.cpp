@@ -48,7 +48,10 @@ glm::dvec3 Simulation::air_velocity_vehicle() const {
 void Simulation::sub_step() {
   state_.sim_time_s = static_cast<double>(++state_.sub_steps) * config_.sub_step_s;
   wipers_.advance(config_.sub_step_s, state_.wipers);
-  if (++sub_steps_since_water_ < config_.windshield.sub_steps_per_water_step) return;
+  if (!config_.simulate_water ||
+      ++sub_steps_since_water_ < config_.windshield.sub_steps_per_water_step) {
+    return;
+  }
   WaterInputs in;
   in.rain_rate_mm_h = state_.weather.rain_rate_mm_h;
   in.air_velocity_mps = air_velocity_vehicle();

@@ -17,6 +17,7 @@ namespace downpour::sim {
 struct SimulationConfig {
   double sub_step_s = 1.0 / 240.0;  // fixed, so that lockstep runs reproduce
   WindshieldConfig windshield;
+  bool simulate_water = true;  // false: the glass stays dry (tools and tests of other effects)
 };
 
 // What the renderer reads: a copy, taken on the render thread after a step.

@@ -10,6 +10,7 @@
 #include "server/render/renderer.hpp"
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"
+#include "tests/render/render_fixture.hpp"
 #include "tests/render/windshield_fixture.hpp"
 #include "tests/support/png_io.hpp"
 
@@ -21,34 +22,24 @@ using testing::RgbaImage;
 constexpr int kWidth = 256;
 constexpr int kHeight = 144;
 
-class RendererTest : public ::testing::Test {
+class RendererTest : public testing::RenderTest {
  protected:
-  static void SetUpTestSuite() { renderer_ = Renderer::create({}).release(); }
-  static void TearDownTestSuite() {
-    delete renderer_;
-    renderer_ = nullptr;
-  }
-
   // The highway scene 10 s in: on the straight, heavy rain; the windshield as the simulation
   // left it.
   static sim::SceneState highway_scene(double rain_mm_h = 25.0, double cloudiness = 0.95) {
     return testing::highway_scene(rain_mm_h, cloudiness);
   }
-  // The same with a dry windshield and no blades on it.
+  // The same with a dry windshield and no blades on it (the water not simulated).
   static sim::SceneState dry_highway_scene(double rain_mm_h = 25.0, double cloudiness = 0.95) {
-    sim::SceneState scene = highway_scene(rain_mm_h, cloudiness);
+    sim::SceneState scene = testing::highway_scene(rain_mm_h, cloudiness, false);
     scene.windshield = sim::WindshieldState{};
     return scene;
   }
 
   static RgbaImage render(sim::View view, const sim::SceneState& scene) {
-    const sim::ViewSpec spec{view, kWidth, kHeight, 85, 0.0, std::nullopt};
-    return {kWidth, kHeight, render_image(*renderer_, spec, scene)};
+    return RenderTest::render(view_spec(view, kWidth, kHeight), scene);
   }
-
-  static Renderer* renderer_;
 };
-Renderer* RendererTest::renderer_ = nullptr;
 
 class GoldenTest : public RendererTest, public ::testing::WithParamInterface<sim::View> {};
 
@@ -83,7 +74,7 @@ INSTANTIATE_TEST_SUITE_P(Views, GoldenTest,
 TEST_F(RendererTest, SkyDarkensAsTheRainRateRises) {
   double previous = 1e9;
   for (double rain : {0.0, 2.0, 10.0, 50.0, 200.0}) {
-    const RgbaImage image = render(sim::View::kRoad, highway_scene(rain, 0.3));
+    const RgbaImage image = render(sim::View::kRoad, dry_highway_scene(rain, 0.3));
     // The top fifth of the chase view is sky.
     const double sky = testing::mean_luma(image, 0, 0, kWidth, kHeight / 5);
     EXPECT_LT(sky, previous) << "rain " << rain << " mm/h";
@@ -94,7 +85,7 @@ TEST_F(RendererTest, SkyDarkensAsTheRainRateRises) {
 TEST_F(RendererTest, WetAsphaltIsDarkerThanDry) {
   // The road just ahead of the car in the chase view, between the lane lines, below the car.
   const auto road = [&](double rain) {
-    const RgbaImage image = render(sim::View::kRoad, highway_scene(rain, 0.6));
+    const RgbaImage image = render(sim::View::kRoad, dry_highway_scene(rain, 0.6));
     return testing::mean_luma(image, kWidth / 8, kHeight * 7 / 8, kWidth / 3, kHeight);
   };
   EXPECT_LT(road(25.0), road(0.0) * 0.9);

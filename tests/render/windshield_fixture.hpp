@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <map>
 #include <numbers>
+#include <tuple>
 #include <utility>
 
 #include "server/sim/scenario.hpp"
@@ -18,19 +19,24 @@
 namespace downpour::testing {
 
 // The render tests' scene: the highway 10 s in, on the straight, heavy rain; the windshield as the
-// simulation left it (replace it for tests about the water). Simulated once per weather and kept:
-// ten seconds of water on the glass take a while.
-inline sim::SceneState highway_scene(double rain_mm_h = 25.0, double cloudiness = 0.95) {
-  static std::map<std::pair<double, double>, sim::SceneState> simulated;
-  const auto it = simulated.find({rain_mm_h, cloudiness});
+// simulation left it (replace it for tests about the water), or dry glass without simulating the
+// water (for tests of other effects: ten seconds of heavy rain on the glass take a while).
+// Simulated once per weather and kept.
+inline sim::SceneState highway_scene(double rain_mm_h = 25.0, double cloudiness = 0.95,
+                                     bool water = true) {
+  static std::map<std::tuple<double, double, bool>, sim::SceneState> simulated;
+  const std::tuple key(rain_mm_h, cloudiness, water);
+  const auto it = simulated.find(key);
   if (it != simulated.end()) return it->second;
   const sim::Scenario scenario = sim::highway_heavy_rain();
   sim::Update update = scenario.at(10.0);
   update.weather->rain_rate_mm_h = rain_mm_h;
   update.weather->cloudiness = cloudiness;
-  sim::Simulation simulation(scenario.seed, update);
+  sim::SimulationConfig config;
+  config.simulate_water = water;
+  sim::Simulation simulation(scenario.seed, update, config);
   simulation.advance(10.0);
-  return simulated.emplace(std::pair(rain_mm_h, cloudiness), simulation.state()).first->second;
+  return simulated.emplace(key, simulation.state()).first->second;
 }
 
 // A small deterministic generator (splitmix64): the same pictures on every standard library.

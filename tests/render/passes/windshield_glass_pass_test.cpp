@@ -11,6 +11,7 @@
 #include "server/render/camera.hpp"
 #include "server/render/renderer.hpp"
 #include "server/sim/pose.hpp"
+#include "tests/render/render_fixture.hpp"
 #include "tests/render/windshield_fixture.hpp"
 #include "tests/support/png_io.hpp"
 
@@ -22,38 +23,32 @@ using testing::RgbaImage;
 constexpr int kWidth = 256;
 constexpr int kHeight = 144;
 
-class WindshieldGlassPassTest : public ::testing::Test {
+class WindshieldGlassPassTest : public testing::RenderTest {
  protected:
   static void SetUpTestSuite() {
-    renderer_ = Renderer::create({}).release();
-    scene_ = new sim::SceneState(testing::highway_scene());
-    scene_->windshield = sim::WindshieldState{};
-  }
-  static void TearDownTestSuite() {
-    delete renderer_;
-    delete scene_;
-    renderer_ = nullptr;
+    RenderTest::SetUpTestSuite();
+    scene_ = testing::highway_scene(25.0, 0.95, false);  // dry glass: each test brings its water
   }
 
-  static sim::ViewSpec cockpit() { return {sim::View::kCockpit, kWidth, kHeight, 85, 0.0, {}}; }
+  static sim::ViewSpec cockpit() { return view_spec(sim::View::kCockpit, kWidth, kHeight); }
   static RgbaImage render(const sim::WindshieldState& water,
                           const sim::ViewSpec& spec = cockpit()) {
-    sim::SceneState scene = *scene_;
+    sim::SceneState scene = scene_;
     scene.windshield = water;
-    return {spec.width, spec.height, render_image(*renderer_, spec, scene)};
+    return RenderTest::render(spec, scene);
   }
   // The pixel (x right, y down) where a glass point (mm) or a vehicle-frame point shows.
   static glm::ivec2 pixel_of(const glm::dvec3& vehicle_point,
                              const sim::ViewSpec& spec = cockpit()) {
-    const Camera camera = make_camera(spec, scene_->vehicle);
+    const Camera camera = make_camera(spec, scene_.vehicle);
     const glm::dvec4 clip = glm::dmat4(camera.projection * camera.view) *
-                            sim::vehicle_to_world(scene_->vehicle) * glm::dvec4(vehicle_point, 1.0);
+                            sim::vehicle_to_world(scene_.vehicle) * glm::dvec4(vehicle_point, 1.0);
     const glm::dvec2 ndc = glm::dvec2(clip) / clip.w;
     return {static_cast<int>((ndc.x * 0.5 + 0.5) * spec.width),
             static_cast<int>((0.5 - ndc.y * 0.5) * spec.height)};
   }
   static glm::ivec2 glass_pixel(glm::dvec2 uv_mm) {
-    return pixel_of(scene_->glass.to_vehicle(uv_mm));
+    return pixel_of(scene_.glass.to_vehicle(uv_mm));
   }
 
   static double luma(const RgbaImage& image, glm::ivec2 p) {
@@ -78,11 +73,8 @@ class WindshieldGlassPassTest : public ::testing::Test {
       testing::write_png(::testing::TempDir() + name, image);
   }
 
-  static Renderer* renderer_;
-  static sim::SceneState* scene_;
+  static inline sim::SceneState scene_;
 };
-Renderer* WindshieldGlassPassTest::renderer_ = nullptr;
-sim::SceneState* WindshieldGlassPassTest::scene_ = nullptr;
 
 // Drops of 2.5 mm radius every 7 mm over a square of glass.
 sim::WindshieldState drop_patch(glm::dvec2 centre_mm, double half_mm) {
@@ -157,7 +149,7 @@ TEST_F(WindshieldGlassPassTest, WiperBladesAreDarkStrips) {
     const glm::dvec2 dir(std::cos(blade.angle_rad), std::sin(blade.angle_rad));
     for (double along : {0.5, 0.7, 0.9}) {
       const glm::dvec2 uv = glm::dvec2(blade.pivot_mm) + along * blade.length_mm * dir;
-      if (!scene_->glass.contains(uv)) continue;
+      if (!scene_.glass.contains(uv)) continue;
       const glm::ivec2 p = glass_pixel(uv);
       if (p.x < 0 || p.x >= kWidth || p.y < 0 || p.y >= kHeight) continue;
       // Near black, blended at 256 x 144 with what lies around the strip.
@@ -171,7 +163,7 @@ TEST_F(WindshieldGlassPassTest, WiperBladesAreDarkStrips) {
 
 TEST_F(WindshieldGlassPassTest, ADashCameraSeesTheDropsOutOfFocus) {
   const WindshieldGlassConfig config;
-  const sim::GlassConfig& glass = scene_->glass;
+  const sim::GlassConfig& glass = scene_.glass;
   sim::ViewSpec dash = cockpit();
   dash.camera = dash_camera_pose();
   EXPECT_EQ(camera_defocus_mm(cockpit(), glass, config), 0.0);  // the driver's eye: in focus

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "server/render/renderer.hpp"
+#include "tests/render/render_fixture.hpp"
 #include "tests/render/windshield_fixture.hpp"
 #include "tests/support/png_io.hpp"
 
@@ -18,27 +19,21 @@ using testing::RgbaImage;
 constexpr int kWidth = 256;
 constexpr int kHeight = 144;
 
-class WindshieldPassTest : public ::testing::Test {
+class WindshieldPassTest : public testing::RenderTest {
  protected:
   static void SetUpTestSuite() {
-    renderer_ = Renderer::create({}).release();
-    scene_ = new sim::SceneState(testing::highway_scene());
-  }
-  static void TearDownTestSuite() {
-    delete renderer_;
-    delete scene_;
-    renderer_ = nullptr;
+    RenderTest::SetUpTestSuite();
+    scene_ = testing::highway_scene(25.0, 0.95, false);  // dry glass: each test brings its water
   }
 
   static RgbaImage render(const sim::WindshieldState& water) {
-    sim::SceneState scene = *scene_;
+    sim::SceneState scene = scene_;
     scene.windshield = water;
-    const sim::ViewSpec spec{sim::View::kWindshield, kWidth, kHeight, 85, 0.0, {}};
-    return {kWidth, kHeight, render_image(*renderer_, spec, scene)};
+    return RenderTest::render(view_spec(sim::View::kWindshield, kWidth, kHeight), scene);
   }
   // The view's pixel of a glass point, as windshield.frag fits the glass (10 % margin).
   static glm::ivec2 pixel(glm::dvec2 uv_mm) {
-    const sim::GlassConfig& g = scene_->glass;
+    const sim::GlassConfig& g = scene_.glass;
     const double aspect = double(kWidth) / kHeight;
     const double mm_per_pixel = std::max(g.bottom_width_mm / aspect, g.height_mm) * 1.1 / kHeight;
     return {static_cast<int>(kWidth / 2 + (uv_mm.x - 0.5 * g.bottom_width_mm) / mm_per_pixel),
@@ -48,11 +43,8 @@ class WindshieldPassTest : public ::testing::Test {
     return &image.pixels[(static_cast<std::size_t>(p.y) * image.width + p.x) * 4];
   }
 
-  static Renderer* renderer_;
-  static sim::SceneState* scene_;
+  static inline sim::SceneState scene_;
 };
-Renderer* WindshieldPassTest::renderer_ = nullptr;
-sim::SceneState* WindshieldPassTest::scene_ = nullptr;
 
 TEST_F(WindshieldPassTest, ShowsWaterWhereTheMetaballsAreAndBlackElsewhere) {
   sim::WindshieldState water;
@@ -71,7 +63,7 @@ TEST_F(WindshieldPassTest, ShowsWaterWhereTheMetaballsAreAndBlackElsewhere) {
     EXPECT_EQ(p[0] + p[1] + p[2], 0) << "dry glass at " << dry.x << ", " << dry.y;
   }
   // Every lit pixel inside the glass lies near a splash (or on the outline).
-  const sim::GlassConfig& g = scene_->glass;
+  const sim::GlassConfig& g = scene_.glass;
   int lit_far_from_water = 0;
   for (double u = 20.0; u < g.bottom_width_mm - 20.0; u += 10.0) {
     for (double v = 20.0; v < g.height_mm - 20.0; v += 10.0) {

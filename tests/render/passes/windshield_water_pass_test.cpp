@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "server/render/renderer.hpp"
+#include "tests/render/render_fixture.hpp"
 
 namespace downpour::render {
 namespace {
@@ -31,14 +32,8 @@ double compressed(double v) {
   return v;
 }
 
-class WindshieldWaterPassTest : public ::testing::Test {
+class WindshieldWaterPassTest : public testing::RenderTest {  // for the GL context
  protected:
-  static void SetUpTestSuite() { renderer_ = Renderer::create({}).release(); }  // the GL context
-  static void TearDownTestSuite() {
-    delete renderer_;
-    renderer_ = nullptr;
-  }
-
   void SetUp() override { pass_ = std::make_unique<WindshieldWaterPass>(); }
 
   void render(const std::vector<sim::Metaball>& metaballs) {
@@ -77,13 +72,11 @@ class WindshieldWaterPassTest : public ::testing::Test {
     return water_[(static_cast<std::size_t>(j) * kWidth + i) * 4 + channel];
   }
 
-  static Renderer* renderer_;
   std::unique_ptr<WindshieldWaterPass> pass_;
   std::vector<sim::Metaball> metaballs_;
   std::vector<float> heights_;
   std::vector<std::uint8_t> water_;
 };
-Renderer* WindshieldWaterPassTest::renderer_ = nullptr;
 
 // One metaball of R = 16 mm centred on texel (200, 150).
 const sim::Metaball kIsolated{401.0f, 301.0f, 16.0f};
