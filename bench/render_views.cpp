@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/view_costs.hpp"
 #include "server/render/camera.hpp"
 #include "server/render/renderer.hpp"
 #include "server/render/view_wet_fraction.hpp"
@@ -31,67 +32,15 @@ namespace {
 
 using namespace downpour;
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
-}
-
-// CPU time of the process (every llvmpipe thread): steadier than wall time on a busy machine.
-double cpu_time_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
-}
-
-struct NamedView {
-  std::string name;
-  sim::ViewSpec spec;
-};
+using bench::NamedView;
 
 void measure(const std::vector<NamedView>& views, const sim::SceneState& wet, int frames) {
-  const sim::SceneState dry = [&] {
-    sim::SceneState s = wet;
-    s.windshield = sim::WindshieldState{};
-    return s;
-  }();
-  {
-    auto renderer = render::Renderer::create({});
-    for (const NamedView& v : views) {
-      for (const auto* scene : {&wet, &dry}) {
-        std::vector<double> ms, cpu_ms;
-        for (int i = 0; i < frames + 2; ++i) {
-          const double c0 = cpu_time_ms();
-          const auto t0 = std::chrono::steady_clock::now();
-          render::render_image(*renderer, v.spec, *scene);
-          const auto t1 = std::chrono::steady_clock::now();
-          if (i < 2) continue;
-          ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
-          cpu_ms.push_back(cpu_time_ms() - c0);
-        }
-        std::printf("%s %dx%d %s frame (profiling off): median %.2f ms, CPU %.2f ms\n",
-                    v.name.c_str(), v.spec.width, v.spec.height, scene == &wet ? "wet" : "dry",
-                    median(ms), median(cpu_ms));
-      }
-    }
-  }
-  auto renderer = render::Renderer::create({});
-  renderer->set_profiling(true);
-  for (const NamedView& v : views) {
-    std::map<std::string, std::vector<double>> passes;
-    std::vector<std::string> order;
-    for (int i = 0; i < frames + 2; ++i) {
-      render::render_image(*renderer, v.spec, wet);
-      if (i < 2) continue;
-      for (const auto& p : renderer->last_pass_timings()) {
-        if (!passes.count(p.name)) order.push_back(p.name);
-        passes[p.name].push_back(p.ms);
-      }
-    }
-    std::printf("%s %dx%d passes (profiling on, median ms):", v.name.c_str(), v.spec.width,
-                v.spec.height);
-    for (const std::string& name : order)
-      std::printf(" %s %.2f", name.c_str(), median(passes[name]));
-    std::printf("\n");
+  for (const bench::ViewCost& c : bench::measure_views(views, wet, frames)) {
+    std::printf("%s %dx%d frame (profiling off): wet %.2f ms (CPU %.2f), dry %.2f ms (CPU %.2f)\n",
+                c.name.c_str(), c.width, c.height, c.wet_ms, c.wet_cpu_ms, c.dry_ms, c.dry_cpu_ms);
+    std::printf("%s %dx%d passes (profiling on, median ms):", c.name.c_str(), c.width, c.height);
+    for (const auto& [name, ms] : c.passes) std::printf(" %s %.2f", name.c_str(), ms);
+    std::printf("; windshield passes %.2f\n", c.windshield_passes_ms());
   }
 }
 

@@ -1,6 +1,8 @@
-// The windshield's own cost (issue 3): the water simulation's step per frame in the standard
-// heavy-rain drive, and its load (drops, particles, metaballs, wet glass), as JSON. Reports,
-// never fails on a slow machine.
+// The windshield's own cost (issue 3), as JSON: the water simulation's step per frame in a
+// standard drive and its load (drops, particles, metaballs, wet glass); then the COCKPIT view's
+// render cost, each pass and the whole frame wet and dry, at each --size, for two windshields:
+// a hand-made one of about --metaballs metaballs (the paper's load: 3000) and the one the drive
+// left. Reports, never fails on a slow machine.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -10,18 +12,41 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "bench/view_costs.hpp"
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"
+#include "tests/render/windshield_fixture.hpp"
 
 namespace {
 
 using namespace downpour;
 using Clock = std::chrono::steady_clock;
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
+using bench::median;
+
+nlohmann::json render_costs(const sim::SceneState& scene, const std::vector<std::string>& sizes,
+                            int frames) {
+  std::vector<bench::NamedView> views;
+  for (const std::string& size : sizes) {
+    const auto x = size.find('x');
+    const int width = std::stoi(size.substr(0, x)), height = std::stoi(size.substr(x + 1));
+    views.push_back({"COCKPIT", {sim::View::kCockpit, width, height, 85, 0.0, std::nullopt}});
+  }
+  nlohmann::json out = nlohmann::json::array();
+  for (const bench::ViewCost& c : bench::measure_views(views, scene, frames)) {
+    nlohmann::json passes = nlohmann::json::object();
+    for (const auto& [name, ms] : c.passes) passes[name] = ms;
+    out.push_back({{"view", c.name},
+                   {"width", c.width},
+                   {"height", c.height},
+                   {"frame_ms_wet", c.wet_ms},
+                   {"frame_ms_dry", c.dry_ms},
+                   {"frame_cpu_ms_wet", c.wet_cpu_ms},
+                   {"frame_cpu_ms_dry", c.dry_cpu_ms},
+                   {"windshield_passes_ms", c.windshield_passes_ms()},
+                   {"passes_ms", passes}});
+  }
+  return out;
 }
 
 }  // namespace
@@ -36,6 +61,21 @@ int main(int argc, char** argv) {
   app.add_option("--seconds", seconds, "simulated seconds of the highway_heavy_rain drive");
   app.add_option("--fps", fps);
   app.add_flag("--trace", trace, "print the load every simulated second on stderr");
+  std::vector<std::string> sizes{"640x360", "1280x720"};
+  int render_frames = 30;
+  int hand_made_metaballs = 3000;
+  app.add_option("--size", sizes, "COCKPIT sizes to render, WIDTHxHEIGHT")
+      ->check([](const std::string& s) {
+        const auto x = s.find('x');
+        const bool ok = x != std::string::npos && x > 0 && x + 1 < s.size() &&
+                        s.find_first_not_of("0123456789x") == std::string::npos &&
+                        std::stoi(s.substr(0, x)) <= 4096 && std::stoi(s.substr(x + 1)) <= 4096;
+        return ok ? std::string() : "expected WIDTHxHEIGHT, e.g. 640x360";
+      });
+  app.add_option("--render-frames", render_frames, "frames per measurement; 0: no rendering")
+      ->check(CLI::Range(0, 10000));
+  app.add_option("--metaballs", hand_made_metaballs, "the hand-made windshield's load")
+      ->check(CLI::Range(0, 100000));
   CLI11_PARSE(app, argc, argv);
 
   const sim::Scenario scenario =
@@ -81,6 +121,20 @@ int main(int argc, char** argv) {
   out["drops_median"] = median(drops);
   out["particles_median"] = median(particles);
   out["glass_wet_fraction_median"] = median(wet);
+  if (render_frames > 0) {
+    const sim::SceneState& simulated = simulation.state();
+    sim::SceneState hand_made_scene = simulated;
+    hand_made_scene.windshield =
+        testing::rainy_windshield(hand_made_scene.glass, hand_made_metaballs);
+    const sim::SceneState& hand_made = hand_made_scene;
+    out["render"] = nlohmann::json::array();
+    for (const auto& [name, scene] :
+         {std::pair("hand_made", &hand_made), std::pair("simulated", &simulated)}) {
+      out["render"].push_back({{"windshield", name},
+                               {"metaballs", scene->windshield.metaballs.size()},
+                               {"views", render_costs(*scene, sizes, render_frames)}});
+    }
+  }
   std::printf("%s\n", out.dump(2).c_str());
   return 0;
 }
