@@ -1,7 +1,7 @@
 // Renders the views of a standard scene at a given time to PNG files, to look at what the
 // renderer draws. Usage:
 //   downpour-render-views OUT_DIR [highway_heavy_rain|city_drizzle] [t_s] [width height]
-//     [rain_rate_mm_h] [--windshield N] [--blades A B] [--dash] [--measure FRAMES]
+//     [rain_rate_mm_h] [--windshield N] [--blades A B] [--dash] [--measure FRAMES] [--wipe]
 // --windshield N: a hand-made rainy windshield (tests/render/windshield_fixture.hpp) of about N
 //   metaballs instead of the simulation's, with the wiper blades at A and B degrees from +u
 //   (--blades; default 40 36); N = 0: the render tests' golden windshield. --dash: also the COCKPIT
@@ -10,6 +10,9 @@
 //   frames with profiling off, wall and CPU time of all threads (and the same frame with a dry
 //   windshield, no blades), then each
 //   pass with profiling on, in a renderer of its own (a glFinish mid-frame slows llvmpipe).
+// --wipe: a wipe as a picture sequence: the scene's weather and drive at t_s with the wipers off
+//   for t_s seconds, then one SINGLE wipe; COCKPIT, WINDSHIELD (and --dash) written before it,
+//   every sixth of the cycle through it, and after (wipe_K_*.png).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -18,6 +21,8 @@
 #include <map>
 #include <string>
 #include <vector>
+
+#include <glm/trigonometric.hpp>
 
 #include "bench/view_costs.hpp"
 #include "server/render/camera.hpp"
@@ -44,6 +49,44 @@ void measure(const std::vector<NamedView>& views, const sim::SceneState& wet, in
   }
 }
 
+// The wipers off for dry_s, then one wipe (SINGLE) in the same weather and drive, 30 frames a
+// second; pictures before the wipe, at every sixth of its cycle and after it.
+int wipe_sequence(const std::string& out, std::uint64_t seed, sim::Update update, double dry_s,
+                  int width, int height, bool dash) {
+  update.wipers = sim::WiperState{sim::WiperMode::kOff};
+  sim::Simulation simulation(seed, update);
+  simulation.advance(dry_s);
+  update.wipers = sim::WiperState{sim::WiperMode::kSingle};
+  simulation.apply(update);
+  const double cycle_s = 60.0 / sim::WiperConfig{}.low_cycles_per_min;
+  std::vector<NamedView> views{
+      {"COCKPIT", {sim::View::kCockpit, width, height, 85, 0.0, {}}},
+      {"WINDSHIELD", {sim::View::kWindshield, width, height, 85, 0.0, {}}}};
+  if (dash) {
+    views.push_back({"COCKPIT_dash",
+                     {sim::View::kCockpit, width, height, 85, 0.0, render::dash_camera_pose()}});
+  }
+  auto renderer = render::Renderer::create({});
+  const int frames_per_picture = static_cast<int>(std::lround(cycle_s / 6.0 * 30.0));
+  for (int k = 0; k <= 7; ++k) {
+    const sim::SceneState& scene = simulation.state();
+    for (const NamedView& v : views) {
+      render::render_image(*renderer, v.spec, scene);
+      testing::RgbaImage image{width, height, render::render_image(*renderer, v.spec, scene)};
+      const std::string path = out + "/wipe_" + std::to_string(k) + "_" + v.name + ".png";
+      testing::write_png(path, image);
+    }
+    std::printf(
+        "wipe_%d: t %.2f s, blades %.1f %.1f deg, %zu metaballs, glass wet %.3f, "
+        "view wet %.3f\n",
+        k, scene.sim_time_s - dry_s, glm::degrees(scene.windshield.blades[0].angle_rad),
+        glm::degrees(scene.windshield.blades[1].angle_rad), scene.windshield.metaballs.size(),
+        scene.windshield.glass_wet_fraction, render::view_wet_fraction(views[0].spec, scene));
+    for (int f = 0; f < frames_per_picture; ++f) simulation.advance(1.0 / 30.0);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -52,6 +95,7 @@ int main(int argc, char** argv) {
   std::array<double, 2> blades{40.0, 36.0};
   bool dash = false;
   int measure_frames = 0;
+  bool wipe = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--windshield" && i + 1 < argc) {
@@ -61,6 +105,8 @@ int main(int argc, char** argv) {
       i += 2;
     } else if (arg == "--dash") {
       dash = true;
+    } else if (arg == "--wipe") {
+      wipe = true;
     } else if (arg == "--measure" && i + 1 < argc) {
       measure_frames = std::atoi(argv[++i]);
     } else {
@@ -70,7 +116,7 @@ int main(int argc, char** argv) {
   if (positional.empty()) {
     std::fprintf(stderr,
                  "usage: downpour-render-views OUT_DIR [scene] [t_s] [width height] [rain_mm_h]"
-                 " [--windshield N] [--blades A B] [--dash] [--measure FRAMES]\n");
+                 " [--windshield N] [--blades A B] [--dash] [--measure FRAMES] [--wipe]\n");
     return 2;
   }
   const std::string out = positional[0];
@@ -84,6 +130,7 @@ int main(int argc, char** argv) {
   if (positional.size() > 5 && update.weather)
     update.weather->rain_rate_mm_h = std::atof(positional[5].c_str());
 
+  if (wipe) return wipe_sequence(out, scenario.seed, update, t, width, height, dash);
   sim::Simulation simulation(scenario.seed, update);
   simulation.advance(t);
   sim::SceneState scene = simulation.state();

@@ -32,11 +32,29 @@ glm::dvec2 airflow_on_glass(const WindshieldConfig& c, const WaterInputs& in) {
 
 }  // namespace
 
+// A spherical cap of contact radius a and contact angle q holds pi a^3 t (3 + t^2) / 6 of water,
+// t = tan(q / 2).
+double cap_volume_per_cubed_radius() {
+  const double t = std::tan(0.5 * kContactAngleDeg * M_PI / 180.0);
+  return M_PI * t * (3.0 + t * t) / 6.0;
+}
+
 double drop_radius_mm(double mass_mg) {
-  return std::cbrt(3.0 * std::max(mass_mg, 0.0) / (2.0 * M_PI));
+  static const double per_cubed = cap_volume_per_cubed_radius();
+  return std::cbrt(std::max(mass_mg, 0.0) / per_cubed);
 }
 double drop_mass_mg(double radius_mm) {
-  return 2.0 / 3.0 * M_PI * radius_mm * radius_mm * radius_mm;
+  static const double per_cubed = cap_volume_per_cubed_radius();
+  return per_cubed * radius_mm * radius_mm * radius_mm;
+}
+double drop_frontal_area_mm2(double radius_mm) {
+  // The cap seen along the glass: a circular segment of the sphere (radius a / sin q) over the
+  // angle 2q.
+  static const double per_squared = [] {
+    const double q = kContactAngleDeg * M_PI / 180.0, sphere = 1.0 / std::sin(q);
+    return 0.5 * sphere * sphere * (2.0 * q - std::sin(2.0 * q));
+  }();
+  return per_squared * radius_mm * radius_mm;
 }
 double terminal_speed_mps(double d_mm) {
   return std::max(0.0, 9.65 - 10.3 * std::exp(-0.6 * d_mm));
@@ -200,7 +218,7 @@ void WaterSim::add_particle(glm::dvec2 pos, double mass) {
 glm::dvec2 WaterSim::drive_per_pin(double r, const WaterInputs& in) const {
   const glm::dvec2 air = airflow_on_glass(config_, in);
   const double mass_kg = drop_mass_mg(r) * 1e-6;
-  const double area_m2 = 0.5 * M_PI * r * r * 1e-6;  // a hemisphere's cross-section
+  const double area_m2 = drop_frontal_area_mm2(r) * 1e-6;
   const glm::dvec2 drag =
       0.5 * kAirDensity * config_.water.airflow_coefficient * area_m2 * glm::length(air) * air;
   return (mass_kg * gravity_ + drag) / (pin_per_mm_ * std::max(r, 1e-6));
@@ -296,7 +314,7 @@ void WaterSim::move_drop(int i, double dt) {
   {
     const Drop& d = drops_[i];
     const double mass_kg = d.mass * 1e-6;
-    const double area_m2 = 0.5 * M_PI * d.radius * d.radius * 1e-6;
+    const double area_m2 = drop_frontal_area_mm2(d.radius) * 1e-6;
     // The air parts around the cabin: over the glass it also spreads out towards the pillars.
     const double half = 0.5 * config_.glass.bottom_width_mm;
     const glm::dvec2 air = air_ + glm::dvec2(air_spread_ * (d.pos.x - half) / half, 0.0);

@@ -70,13 +70,13 @@ struct WaterConfig {
   double mobility_mm_s = 60.0;      // flow speed of a drop whose drive is twice its pinning
   double max_speed_mm_s = 400.0;
   double trail_fraction = 0.01;       // of a moving drop's mass left behind per cell moved
-  double trail_min_mass_mg = 0.02;    // smaller trail drops are not left
+  double trail_min_mass_mg = 0.05;    // smaller trail drops are not left
   double trail_lifetime_s = 4.0;      // a trail drop's radius shrinks to nothing over this time
   double sub_metaball_merge_s = 0.6;  // impact sub-metaballs migrate into the main one over this
   int impact_sub_metaballs = 3;
   double sub_metaball_offset = 0.9;   // initial offset, in main radii
   double sub_metaball_radius = 0.55;  // in main radii
-  double particle_radius_mm = 1.2;    // particle model: equal particles
+  double particle_radius_mm = 1.8;    // particle model: equal particles (3.5 mg each)
   double penalty = 0.25;              // repulsion: extra push as a fraction of the overlap
   int region_particle_diameters = 4;  // particle region: blade width + this many diameters a side
   int suspension_cells = 7;           // 7 x 7 search before a particle becomes a mesh drop
