@@ -187,6 +187,19 @@ class ServerTest(unittest.TestCase):
                             [b[pb.VIEW_COCKPIT] for b in other])
         self.assertEqual([a[pb.VIEW_ROAD] for a in first], [b[pb.VIEW_ROAD] for b in other])
 
+    def test_frame_stats_count_the_water_on_the_glass(self):
+        session_id = self.open_session()
+        frames = []
+        for step in range(1, 7):
+            frames = {f.view: f for f in self.client.step(session_id, DT, inputs(step))}
+        cockpit, road = frames[pb.VIEW_COCKPIT].stats, frames[pb.VIEW_ROAD].stats
+        self.assertGreater(cockpit.drops_on_glass, 50)  # 0.3 s of 20 mm/h at 72 km/h
+        self.assertGreater(cockpit.glass_wet_fraction, 0.0)
+        self.assertLess(cockpit.glass_wet_fraction, 0.5)
+        self.assertGreater(cockpit.view_wet_fraction, 0.0)
+        self.assertEqual(road.drops_on_glass, cockpit.drops_on_glass)
+        self.assertEqual(road.view_wet_fraction, 0.0)  # the chase camera sees no windshield
+
     def test_realtime_frames_stream_to_a_watcher(self):
         session_id = self.open_session(views=[VIEWS[0]], mode=pb.MODE_REALTIME, fps=20)
         call = self.client.watch_frames(session_id)
