@@ -8,6 +8,7 @@
 
 #include "server/render/renderer.hpp"
 #include "server/sim/simulation.hpp"
+#include "tests/render/windshield_fixture.hpp"
 #include "tests/support/png_io.hpp"
 
 namespace downpour::testing {
@@ -24,6 +25,17 @@ class RenderTest : public ::testing::Test {
     return {spec.width, spec.height, render::render_image(*renderer_, spec, scene)};
   }
   static render::Renderer& renderer() { return *renderer_; }
+
+  // The highway scene with dry glass, its water not simulated: for tests that bring their own.
+  static const sim::SceneState& dry_scene() {
+    static const sim::SceneState scene = highway_scene(25.0, 0.95, false);
+    return scene;
+  }
+  static RgbaImage render_water(const sim::WindshieldState& water, const sim::ViewSpec& spec) {
+    sim::SceneState scene = dry_scene();
+    scene.windshield = water;
+    return render(spec, scene);
+  }
 
  private:
   static inline std::unique_ptr<render::Renderer> renderer_;

@@ -25,30 +25,24 @@ constexpr int kHeight = 144;
 
 class WindshieldGlassPassTest : public testing::RenderTest {
  protected:
-  static void SetUpTestSuite() {
-    RenderTest::SetUpTestSuite();
-    scene_ = testing::highway_scene(25.0, 0.95, false);  // dry glass: each test brings its water
-  }
-
   static sim::ViewSpec cockpit() { return view_spec(sim::View::kCockpit, kWidth, kHeight); }
   static RgbaImage render(const sim::WindshieldState& water,
                           const sim::ViewSpec& spec = cockpit()) {
-    sim::SceneState scene = scene_;
-    scene.windshield = water;
-    return RenderTest::render(spec, scene);
+    return render_water(water, spec);
   }
   // The pixel (x right, y down) where a glass point (mm) or a vehicle-frame point shows.
   static glm::ivec2 pixel_of(const glm::dvec3& vehicle_point,
                              const sim::ViewSpec& spec = cockpit()) {
-    const Camera camera = make_camera(spec, scene_.vehicle);
+    const Camera camera = make_camera(spec, dry_scene().vehicle);
     const glm::dvec4 clip = glm::dmat4(camera.projection * camera.view) *
-                            sim::vehicle_to_world(scene_.vehicle) * glm::dvec4(vehicle_point, 1.0);
+                            sim::vehicle_to_world(dry_scene().vehicle) *
+                            glm::dvec4(vehicle_point, 1.0);
     const glm::dvec2 ndc = glm::dvec2(clip) / clip.w;
     return {static_cast<int>((ndc.x * 0.5 + 0.5) * spec.width),
             static_cast<int>((0.5 - ndc.y * 0.5) * spec.height)};
   }
   static glm::ivec2 glass_pixel(glm::dvec2 uv_mm, const sim::ViewSpec& spec = cockpit()) {
-    return pixel_of(scene_.glass.to_vehicle(uv_mm), spec);
+    return pixel_of(dry_scene().glass.to_vehicle(uv_mm), spec);
   }
   // The pixel box of a square of glass (the glass is raked: the box of two opposite corners).
   static glm::ivec4 glass_box(glm::dvec2 centre_mm, double half_mm,
@@ -79,8 +73,6 @@ class WindshieldGlassPassTest : public testing::RenderTest {
     if (std::getenv("DOWNPOUR_SAVE_RENDERS"))
       testing::write_png(::testing::TempDir() + name, image);
   }
-
-  static inline sim::SceneState scene_;
 };
 
 // Drops of 2.5 mm radius every 7 mm over a square of glass.
@@ -194,7 +186,7 @@ TEST_F(WindshieldGlassPassTest, WiperBladesAreDarkStrips) {
     const glm::dvec2 dir(std::cos(blade.angle_rad), std::sin(blade.angle_rad));
     for (double along : {0.5, 0.7, 0.9}) {
       const glm::dvec2 uv = glm::dvec2(blade.pivot_mm) + along * blade.length_mm * dir;
-      if (!scene_.glass.contains(uv)) continue;
+      if (!dry_scene().glass.contains(uv)) continue;
       const glm::ivec2 p = glass_pixel(uv);
       if (p.x < 0 || p.x >= kWidth || p.y < 0 || p.y >= kHeight) continue;
       // Near black, blended at 256 x 144 with what lies around the strip.
@@ -208,7 +200,7 @@ TEST_F(WindshieldGlassPassTest, WiperBladesAreDarkStrips) {
 
 TEST_F(WindshieldGlassPassTest, ADashCameraSeesTheDropsOutOfFocus) {
   const WindshieldGlassConfig config;
-  const sim::GlassConfig& glass = scene_.glass;
+  const sim::GlassConfig& glass = dry_scene().glass;
   sim::ViewSpec dash = cockpit();
   dash.camera = dash_camera_pose();
   EXPECT_EQ(camera_defocus_mm(cockpit(), glass, config), 0.0);  // the driver's eye: in focus

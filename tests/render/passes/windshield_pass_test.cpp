@@ -21,19 +21,12 @@ constexpr int kHeight = 144;
 
 class WindshieldPassTest : public testing::RenderTest {
  protected:
-  static void SetUpTestSuite() {
-    RenderTest::SetUpTestSuite();
-    scene_ = testing::highway_scene(25.0, 0.95, false);  // dry glass: each test brings its water
-  }
-
   static RgbaImage render(const sim::WindshieldState& water) {
-    sim::SceneState scene = scene_;
-    scene.windshield = water;
-    return RenderTest::render(view_spec(sim::View::kWindshield, kWidth, kHeight), scene);
+    return render_water(water, view_spec(sim::View::kWindshield, kWidth, kHeight));
   }
   // The view's pixel of a glass point, as windshield.frag fits the glass (10 % margin).
   static glm::ivec2 pixel(glm::dvec2 uv_mm) {
-    const sim::GlassConfig& g = scene_.glass;
+    const sim::GlassConfig& g = dry_scene().glass;
     const double aspect = double(kWidth) / kHeight;
     const double mm_per_pixel = std::max(g.bottom_width_mm / aspect, g.height_mm) * 1.1 / kHeight;
     return {static_cast<int>(kWidth / 2 + (uv_mm.x - 0.5 * g.bottom_width_mm) / mm_per_pixel),
@@ -42,8 +35,6 @@ class WindshieldPassTest : public testing::RenderTest {
   static const std::uint8_t* at(const RgbaImage& image, glm::ivec2 p) {
     return &image.pixels[(static_cast<std::size_t>(p.y) * image.width + p.x) * 4];
   }
-
-  static inline sim::SceneState scene_;
 };
 
 TEST_F(WindshieldPassTest, ShowsWaterWhereTheMetaballsAreAndBlackElsewhere) {
@@ -63,7 +54,7 @@ TEST_F(WindshieldPassTest, ShowsWaterWhereTheMetaballsAreAndBlackElsewhere) {
     EXPECT_EQ(p[0] + p[1] + p[2], 0) << "dry glass at " << dry.x << ", " << dry.y;
   }
   // Every lit pixel inside the glass lies near a splash (or on the outline).
-  const sim::GlassConfig& g = scene_.glass;
+  const sim::GlassConfig& g = dry_scene().glass;
   int lit_far_from_water = 0;
   for (double u = 20.0; u < g.bottom_width_mm - 20.0; u += 10.0) {
     for (double v = 20.0; v < g.height_mm - 20.0; v += 10.0) {
