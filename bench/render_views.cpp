@@ -2,6 +2,8 @@
 // renderer draws. Usage:
 //   downpour-render-views OUT_DIR [highway_heavy_rain|city_drizzle] [t_s] [width height]
 //     [rain_rate_mm_h] [--windshield N] [--blades A B] [--dash] [--measure FRAMES] [--wipe]
+//     [--speed MPS]
+// --speed MPS: the car's speed along its heading (0: standing), in place of the scene's.
 // --windshield N: a hand-made rainy windshield (tests/render/windshield_fixture.hpp) of about N
 //   metaballs instead of the simulation's, with the wiper blades at A and B degrees from +u
 //   (--blades; default 40 36); N = 0: the render tests' golden windshield. --dash: also the COCKPIT
@@ -53,18 +55,18 @@ void measure(const std::vector<NamedView>& views, const sim::SceneState& wet, in
 // second; pictures before the wipe, at every sixth of its cycle and after it.
 int wipe_sequence(const std::string& out, std::uint64_t seed, sim::Update update, double dry_s,
                   int width, int height, bool dash) {
-  update.wipers = sim::WiperState{sim::WiperMode::kOff};
+  update.wipers = sim::WiperState{sim::WiperMode::kOff, 4.0, {}};
   sim::Simulation simulation(seed, update);
   simulation.advance(dry_s);
-  update.wipers = sim::WiperState{sim::WiperMode::kSingle};
+  update.wipers = sim::WiperState{sim::WiperMode::kSingle, 4.0, {}};
   simulation.apply(update);
   const double cycle_s = 60.0 / sim::WiperConfig{}.low_cycles_per_min;
   std::vector<NamedView> views{
-      {"COCKPIT", {sim::View::kCockpit, width, height, 85, 0.0, {}}},
-      {"WINDSHIELD", {sim::View::kWindshield, width, height, 85, 0.0, {}}}};
+      {"COCKPIT", sim::view_spec(sim::View::kCockpit, width, height)},
+      {"WINDSHIELD", sim::view_spec(sim::View::kWindshield, width, height)}};
   if (dash) {
-    views.push_back({"COCKPIT_dash",
-                     {sim::View::kCockpit, width, height, 85, 0.0, render::dash_camera_pose()}});
+    views.push_back({"COCKPIT_dash", sim::view_spec(sim::View::kCockpit, width, height,
+                                                    render::dash_camera_pose())});
   }
   auto renderer = render::Renderer::create({});
   const int frames_per_picture = static_cast<int>(std::lround(cycle_s / 6.0 * 30.0));
@@ -96,6 +98,7 @@ int main(int argc, char** argv) {
   bool dash = false;
   int measure_frames = 0;
   bool wipe = false;
+  double speed = -1.0;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--windshield" && i + 1 < argc) {
@@ -107,6 +110,8 @@ int main(int argc, char** argv) {
       dash = true;
     } else if (arg == "--wipe") {
       wipe = true;
+    } else if (arg == "--speed" && i + 1 < argc) {
+      speed = std::atof(argv[++i]);
     } else if (arg == "--measure" && i + 1 < argc) {
       measure_frames = std::atoi(argv[++i]);
     } else {
@@ -116,7 +121,8 @@ int main(int argc, char** argv) {
   if (positional.empty()) {
     std::fprintf(stderr,
                  "usage: downpour-render-views OUT_DIR [scene] [t_s] [width height] [rain_mm_h]"
-                 " [--windshield N] [--blades A B] [--dash] [--measure FRAMES] [--wipe]\n");
+                 " [--windshield N] [--blades A B] [--dash] [--measure FRAMES] [--wipe]"
+                 " [--speed MPS]\n");
     return 2;
   }
   const std::string out = positional[0];
@@ -129,6 +135,10 @@ int main(int argc, char** argv) {
   sim::Update update = scenario.at(t);
   if (positional.size() > 5 && update.weather)
     update.weather->rain_rate_mm_h = std::atof(positional[5].c_str());
+  if (speed >= 0.0 && update.vehicle) {
+    const double yaw = glm::radians(update.vehicle->rotation.yaw_deg);
+    update.vehicle->velocity_mps = glm::dvec3(std::cos(yaw), std::sin(yaw), 0.0) * speed;
+  }
 
   if (wipe) return wipe_sequence(out, scenario.seed, update, t, width, height, dash);
   sim::Simulation simulation(scenario.seed, update);
@@ -145,11 +155,11 @@ int main(int argc, char** argv) {
   std::vector<NamedView> views;
   for (sim::View view :
        {sim::View::kCockpit, sim::View::kRoad, sim::View::kWindshield, sim::View::kRain}) {
-    views.push_back({std::string(sim::view_name(view)), {view, width, height, 85, 0.0, {}}});
+    views.push_back({std::string(sim::view_name(view)), sim::view_spec(view, width, height)});
   }
   if (dash) {
-    views.push_back({"COCKPIT_dash",
-                     {sim::View::kCockpit, width, height, 85, 0.0, render::dash_camera_pose()}});
+    views.push_back({"COCKPIT_dash", sim::view_spec(sim::View::kCockpit, width, height,
+                                                    render::dash_camera_pose())});
   }
 
   if (measure_frames > 0) {

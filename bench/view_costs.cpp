@@ -27,7 +27,7 @@ double median(std::vector<double> v) {
 double ViewCost::windshield_passes_ms() const {
   double sum = 0.0;
   for (const auto& [name, ms] : passes) {
-    if (name.rfind("windshield", 0) == 0) sum += ms;
+    if (name.rfind("glass_", 0) == 0 || name == "windshield") sum += ms;
   }
   return sum;
 }
@@ -44,7 +44,10 @@ std::vector<ViewCost> measure_views(const std::vector<NamedView>& views, const s
   {
     auto renderer = render::Renderer::create({});
     for (const NamedView& v : views) {
-      ViewCost cost{v.name, v.spec.width, v.spec.height};
+      ViewCost cost;
+      cost.name = v.name;
+      cost.width = v.spec.width;
+      cost.height = v.spec.height;
       for (const sim::SceneState* scene : {&wet, &dry}) {
         std::vector<double> ms, cpu_ms;
         for (int i = 0; i < frames + kWarmUp; ++i) {

@@ -25,7 +25,7 @@ struct ViewCost {
   double wet_ms = 0.0, wet_cpu_ms = 0.0;               // the frame with the scene's water
   double dry_ms = 0.0, dry_cpu_ms = 0.0;               // the same frame, dry glass and no blades
   std::vector<std::pair<std::string, double>> passes;  // in drawing order, median ms
-  // The sum of the passes named windshield_*: the windshield's own cost in the frame.
+  // The sum of the glass passes (glass_*, and the WINDSHIELD view's own): the windshield's cost.
   double windshield_passes_ms() const;
 };
 

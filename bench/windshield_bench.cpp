@@ -30,7 +30,7 @@ nlohmann::json render_costs(const sim::SceneState& scene, const std::vector<std:
   for (const std::string& size : sizes) {
     const auto x = size.find('x');
     const int width = std::stoi(size.substr(0, x)), height = std::stoi(size.substr(x + 1));
-    views.push_back({"COCKPIT", {sim::View::kCockpit, width, height, 85, 0.0, std::nullopt}});
+    views.push_back({"COCKPIT", sim::view_spec(sim::View::kCockpit, width, height)});
   }
   nlohmann::json out = nlohmann::json::array();
   for (const bench::ViewCost& c : bench::measure_views(views, scene, frames)) {

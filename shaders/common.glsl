@@ -1,21 +1,6 @@
-// Shared by every scene shader: the per-frame uniform block (renderer.cpp FrameBlock), sky colour,
-// fog and lighting.
-layout(std140, binding = 0) uniform FrameBlock {
-  mat4 view_proj;
-  mat4 inv_view_proj;
-  vec4 camera_pos;
-  vec4 sun_dir;
-  vec4 sun_radiance;
-  vec4 sky_zenith;
-  vec4 sky_horizon;
-  vec4 ambient;
-  vec4 fog;     // rgb colour, a extinction per metre
-  vec4 params;  // x sim time, y overcast, z wetness, w rain rate (mm/h)
-  vec4 wind;    // xy wind velocity, m/s
-} frame;
-
-layout(binding = 1) uniform sampler2D noise_tex;  // value noise, 4 frequencies in rgba
-
+// Shared by every scene shader: the per-frame uniform block and texture units (interface.glsl,
+// generated from shader_interface.hpp), sky colour, fog and lighting.
+#include "interface.glsl"
 // Sky radiance along a world direction, without clouds. Kept free of pow(): on llvmpipe each
 // pow is a log and an exp per channel, and this runs for every sky pixel.
 vec3 sky_gradient(vec3 dir) {

@@ -6,7 +6,6 @@ in vec2 v_uv;  // x lateral offset (m, left positive), y distance along the trac
 in vec4 v_fog;
 out vec4 out_colour;
 
-layout(binding = 2) uniform sampler2D asphalt_tex;  // rgb relief normal, a height (seed 003, 3.1)
 uniform float u_lane_width;
 uniform int u_lanes_each_way;
 uniform float u_paved_half_width;

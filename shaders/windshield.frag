@@ -2,13 +2,12 @@
 // The WINDSHIELD view: the glass in its own plane fitted to the view. Dry glass is black; water is
 // grey by its compressed height (0.35 at the threshold up to 1 a quarter above it); the outline is
 // faint grey so that the image shows where the glass is; wiper blades are blue.
-#include "windshield_common.glsl"
+#include "interface.glsl"
+#include "wiper_blades.glsl"
 in vec2 v_uv;
 out vec4 out_colour;
-layout(binding = 5) uniform sampler2D water_tex;  // WindshieldWaterPass's water map
-uniform vec3 u_glass_mm;  // bottom width, top width, height
-uniform vec2 u_map_origin_mm;  // the water map covers u_map_extent_mm from here
-uniform vec2 u_map_extent_mm;
+uniform vec3 u_glass_mm;     // bottom width, top width, height
+uniform vec2 u_map_size_mm;  // the glass water map covers [0, size] of glass space
 uniform float u_aspect;
 uniform float u_threshold;
 void main() {
@@ -21,7 +20,7 @@ void main() {
   float inside = clamp(edge_dist / px + 0.5, 0.0, 1.0);
   float outline = inside * (1.0 - smoothstep(px, 2.0 * px, edge_dist));
 
-  vec4 water = textureLod(water_tex, (mm - u_map_origin_mm) / u_map_extent_mm, 0.0);
+  vec4 water = textureLod(glass_water_tex, mm / u_map_size_mm, 0.0);
   float grey = 0.35 + 0.65 * clamp((water.b - u_threshold) * 4.0, 0.0, 1.0);
   vec3 colour = vec3(max(0.25 * outline, grey * water.a * inside));
   vec2 wiper = wiper_coverage(mm, px);

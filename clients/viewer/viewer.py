@@ -21,7 +21,8 @@ from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
 
 import grpc  # noqa: E402
-from downpour_client import DownpourClient, enum_name  # noqa: E402
+from downpour_client import (  # noqa: E402
+    DownpourClient, add_security_arguments, enum_name, security_options)
 from downpour.v1 import downpour_pb2 as pb  # noqa: E402
 
 MIN_RATE_SPAN_S = 0.5
@@ -271,13 +272,14 @@ def make_server(frames, port, host="127.0.0.1"):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--server", default="127.0.0.1:50051", help="host:port of the server")
+    add_security_arguments(parser)
     parser.add_argument("--session", help="follow this session instead of the first one listed")
     parser.add_argument("--port", type=int, default=8080, help="HTTP port on 127.0.0.1")
     parser.add_argument("--max-fps", type=float, default=0.0, help="0 = the session's rate")
     args = parser.parse_args(argv)
 
     frames = LatestFrames()
-    client = DownpourClient(args.server)
+    client = DownpourClient(args.server, **security_options(args))
     follower = Follower(client, frames, args.session, args.max_fps)
     httpd = make_server(frames, args.port)
     signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(0))

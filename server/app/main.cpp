@@ -1,10 +1,13 @@
 // downpour-server: wiring. Parses the configuration, starts the render loop (which makes the GL
 // context and renders a first frame), then serves gRPC until SIGINT or SIGTERM, and drains.
+#include <algorithm>
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <string>
+#include <thread>
 
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/grpcpp.h>
@@ -13,6 +16,7 @@
 
 #include "server/app/server_config.hpp"
 #include "server/rpc/downpour_service.hpp"
+#include "server/rpc/malformed_request.hpp"
 #include "server/session/frame_scheduler.hpp"
 #include "server/session/session_registry.hpp"
 
@@ -22,6 +26,21 @@ int main(int argc, char** argv) {
   const auto config = app::parse_config(argc, argv, &exit_code);
   if (!config) return exit_code;
   spdlog::set_level(spdlog::level::from_str(config->log_level));
+  // Security first: a server that would be exposed, or whose keys or tokens cannot be read, does
+  // not start.
+  if (const std::string problem = app::security_problem(*config); !problem.empty()) {
+    spdlog::critical("{}", problem);
+    return 2;
+  }
+  rpc::Authenticator auth;
+  std::shared_ptr<grpc::ServerCredentials> credentials;
+  try {
+    if (!config->tokens_file.empty()) auth = rpc::Authenticator::from_file(config->tokens_file);
+    credentials = app::server_credentials(*config);
+  } catch (const std::exception& e) {
+    spdlog::critical("{}", e.what());
+    return 2;
+  }
   if (config->render_threads > 0)
     setenv("LP_NUM_THREADS", std::to_string(config->render_threads).c_str(), 1);
 
@@ -36,6 +55,7 @@ int main(int argc, char** argv) {
   session::SessionRegistry registry(config->max_sessions, [&scheduler_ptr] {
     if (scheduler_ptr) scheduler_ptr->wake();
   });
+  registry.set_idle_timeout_s(config->session_idle_timeout_s);
   session::SchedulerOptions options;
   options.renderer.platform = config->renderer;
   options.encoder_threads = config->encoder_threads;
@@ -47,28 +67,68 @@ int main(int argc, char** argv) {
     return 1;
   }
   scheduler_ptr = &scheduler;
-  spdlog::info("renderer: {}", scheduler.stats().renderer);
+  const std::string renderer = scheduler.stats().renderer;
+  spdlog::info("renderer: {}", renderer);
+  const session::AdmissionBudget budget = app::admission_budget(*config, renderer);
+  registry.set_budget(budget);
+  spdlog::info("admission: {:.0f} Mpx/s, {:.0f} MiB of estimated session memory (0 = no limit)",
+               budget.max_pixel_rate / 1e6, budget.max_memory_bytes / (1024.0 * 1024.0));
 
   rpc::Limits limits;
   limits.max_width = config->max_width;
   limits.max_height = config->max_height;
   limits.max_fps = config->max_fps;
-  rpc::DownpourService service(registry, scheduler, limits);
+  rpc::DownpourService service(registry, scheduler, limits, auth);
 
   grpc::EnableDefaultHealthCheckService(true);
+  // Probes that cannot speak TLS get the health service alone, in plaintext, on its own port.
+  // It is built before reflection is enabled (a process-wide plugin), so it offers nothing else.
+  std::unique_ptr<grpc::Server> health_server;
+  if (!config->health_listen.empty()) {
+    grpc::ServerBuilder health_builder;
+    int health_port = 0;
+    health_builder.AddListeningPort(config->health_listen, grpc::InsecureServerCredentials(),
+                                    &health_port);
+    health_server = health_builder.BuildAndStart();
+    if (!health_server || health_port == 0) {
+      spdlog::critical("cannot listen on {} (--health-listen)", config->health_listen);
+      return 1;
+    }
+    health_server->GetHealthCheckService()->SetServingStatus(false);  // until the main port is up
+    spdlog::info("health alone on {} (port {})", config->health_listen, health_port);
+  }
+  // Reflection describes the public schema (proto/) to tools such as grpcurl; the calls it
+  // describes still need their tokens.
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
   int port = 0;
-  builder.AddListeningPort(config->listen, grpc::InsecureServerCredentials(), &port);
+  builder.AddListeningPort(config->listen, credentials, &port);
   builder.RegisterService(&service);
   builder.SetMaxReceiveMessageSize(1 << 20);
+  builder.experimental().SetInterceptorCreators(rpc::malformed_request_interceptors());
+  // Pings find a client whose host died with a stream open (no FIN ever comes): after 20 s of
+  // silence a ping, and 10 s without its answer closes the connection, so the stream's lease on
+  // its session ends and the idle timeout can take it.
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, 20000);
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, 10000);
+  builder.AddChannelArgument(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);  // a quiet stream too
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
   if (!server || port == 0) {
     spdlog::critical("cannot listen on {}", config->listen);
     return 1;
   }
+  auto set_serving = [&](bool serving) {
+    server->GetHealthCheckService()->SetServingStatus(serving);
+    if (health_server) health_server->GetHealthCheckService()->SetServingStatus(serving);
+  };
   // The GL context exists and a first frame rendered (scheduler.start): report SERVING.
-  server->GetHealthCheckService()->SetServingStatus(true);
+  set_serving(true);
+  spdlog::info("security: {}, {}",
+               config->tls_cert.empty()        ? "plaintext"
+               : config->tls_client_ca.empty() ? "TLS"
+                                               : "mutual TLS",
+               auth.requires_tokens() ? std::to_string(auth.token_count()) + " tokens"
+                                      : std::string("no tokens (every client may do everything)"));
   spdlog::info("listening on {} (port {}), up to {} sessions", config->listen, port,
                config->max_sessions);
   if (!config->port_file.empty()) {
@@ -77,14 +137,34 @@ int main(int argc, char** argv) {
     std::rename(tmp.c_str(), config->port_file.c_str());
   }
 
-  timespec wait{
-      static_cast<time_t>(config->stats_interval_s),
-      static_cast<long>((config->stats_interval_s - static_cast<time_t>(config->stats_interval_s)) *
-                        1e9)};
+  // Serve until a signal. Four times a second the watchdog looks at the render loop: one that has
+  // not come round for --watchdog-s turns health NOT_SERVING (a balancer stops sending work) until
+  // it does again. Every --stats-interval a stats line goes to the log.
+  using Clock = std::chrono::steady_clock;
+  const auto stats_every = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(config->stats_interval_s));
+  Clock::time_point next_stats = Clock::now() + stats_every;
+  const timespec quarter{0, 250'000'000};
+  bool serving = true;
   int signal_number = 0;
   for (;;) {
-    signal_number = sigtimedwait(&signals, nullptr, &wait);
+    signal_number = sigtimedwait(&signals, nullptr, &quarter);
     if (signal_number > 0) break;
+    const Clock::time_point now = Clock::now();
+    const double stalled = scheduler.stalled_s(now);
+    const bool healthy = config->watchdog_s <= 0.0 || stalled < config->watchdog_s;
+    if (healthy != serving) {
+      serving = healthy;
+      set_serving(serving);
+      if (serving) {
+        spdlog::warn("watchdog: the render loop came round again; SERVING");
+      } else {
+        spdlog::error("watchdog: the render loop has not come round for {:.1f} s; NOT_SERVING",
+                      stalled);
+      }
+    }
+    if (now < next_stats) continue;
+    next_stats = now + stats_every;
     const session::SchedulerStats s = scheduler.stats();
     spdlog::info(
         "stats: {} sessions, {} frames rendered, {} encoded, render {:.2f} ms, encode {:.2f} ms "
@@ -92,12 +172,47 @@ int main(int argc, char** argv) {
         registry.list().size(), s.frames_rendered, s.frames_encoded, s.render_ms_median,
         s.encode_ms_median);
   }
-  spdlog::info("signal {}: draining", signal_number);
-  server->GetHealthCheckService()->SetServingStatus(false);
-  registry
-      .close_all();  // ends streams and fails queued steps, so that shutdown does not wait on them
-  server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(5));
+  // Drain: refuse new work, answer the steps already accepted, end every stream with UNAVAILABLE,
+  // and be gone within the grace (a second signal skips the wait for steps).
+  const Clock::time_point drain_start = Clock::now();
+  const Clock::time_point deadline =
+      drain_start + std::chrono::duration_cast<Clock::duration>(
+                        std::chrono::duration<double>(config->shutdown_grace_s));
+  // What the steps leave of the grace for ending the streams and stopping the render loop.
+  const auto reserve = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(std::min(2.0, config->shutdown_grace_s * 0.25)));
+  spdlog::info("signal {}: draining ({} steps in flight; grace {:.0f} s)", signal_number,
+               service.steps_in_flight(), config->shutdown_grace_s);
+  // A render loop stuck in the driver cannot stop: past the grace (and a second to log) the
+  // process ends anyway, so that an orchestrator's SIGKILL is never what ends it.
+  std::thread([deadline] {
+    std::this_thread::sleep_until(deadline + std::chrono::seconds(1));
+    spdlog::critical("the drain outlived its grace; exiting now");
+    spdlog::default_logger()->flush();
+    std::_Exit(2);
+  }).detach();
+  service.begin_drain();  // before health says so: a client that sees NOT_SERVING is refused
+  set_serving(false);
+  const timespec poll{0, 10'000'000};
+  while (service.steps_in_flight() > 0 && Clock::now() < deadline - reserve) {
+    if (sigtimedwait(&signals, nullptr, &poll) > 0) {
+      spdlog::warn("second signal: not waiting for the {} steps in flight",
+                   service.steps_in_flight());
+      break;
+    }
+  }
+  if (const int left = service.steps_in_flight(); left > 0)
+    spdlog::warn("{} steps were still in flight at the end of the grace", left);
+  registry.close_all({session::EndReason::kShuttingDown, "server shutting down"});
+  // The streams send their status; one whose reader has stalled cannot, and is cancelled.
+  const Clock::time_point flushed =
+      std::min(Clock::now() + std::chrono::milliseconds(500), deadline);
+  while (service.open_streams() > 0 && Clock::now() < flushed)
+    sigtimedwait(&signals, nullptr, &poll);
+  server->Shutdown(std::chrono::system_clock::now());  // cancels what is left
+  if (health_server) health_server->Shutdown(std::chrono::system_clock::now());
   scheduler.stop();
-  spdlog::info("stopped");
+  spdlog::info("stopped after {:.2f} s of drain",
+               std::chrono::duration<double>(Clock::now() - drain_start).count());
   return 0;
 }

@@ -1,10 +1,85 @@
 #include "server/app/server_config.hpp"
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <fstream>
 #include <map>
+#include <sstream>
+#include <stdexcept>
 
 #include <CLI/CLI.hpp>
 
+#include "server/rpc/auth.hpp"
+
 namespace downpour::app {
+
+namespace {
+
+std::string read_file(const std::string& path, const char* what) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(std::string(what) + ": cannot read " + path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The machine's memory, or the container's limit if lower (cgroup v2's memory.max, or v1's
+// limit_in_bytes, which reads as a huge number when there is none).
+double available_memory_bytes() {
+  double bytes = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * sysconf(_SC_PAGESIZE);
+  for (const char* path :
+       {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
+    std::ifstream limit(path);
+    double cgroup = 0.0;
+    if (limit >> cgroup && cgroup > 0.0) bytes = std::min(bytes, cgroup);  // "max" reads as none
+  }
+  return bytes;
+}
+
+}  // namespace
+
+std::string security_problem(const ServerConfig& c) {
+  if (c.tls_cert.empty() != c.tls_key.empty()) return "--tls-cert and --tls-key go together";
+  if (!c.tls_client_ca.empty() && c.tls_cert.empty())
+    return "--tls-client-ca needs --tls-cert and --tls-key";
+  if (!rpc::loopback_only(c.listen) && !c.allow_insecure_remote &&
+      (c.tls_cert.empty() || c.tokens_file.empty())) {
+    return "listening on " + c.listen +
+           " reaches other machines: give --tls-cert, --tls-key and --tokens-file (README, "
+           "Exposing the server), or --allow-insecure-remote on a network you trust";
+  }
+  return {};
+}
+
+std::shared_ptr<grpc::ServerCredentials> server_credentials(const ServerConfig& c) {
+  if (c.tls_cert.empty()) return grpc::InsecureServerCredentials();
+  grpc::SslServerCredentialsOptions options(
+      c.tls_client_ca.empty() ? GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE
+                              : GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY);
+  options.pem_key_cert_pairs.push_back(
+      {read_file(c.tls_key, "--tls-key"), read_file(c.tls_cert, "--tls-cert")});
+  if (!c.tls_client_ca.empty())
+    options.pem_root_certs = read_file(c.tls_client_ca, "--tls-client-ca");
+  return grpc::SslServerCredentials(options);
+}
+
+session::AdmissionBudget admission_budget(const ServerConfig& config, const std::string& renderer) {
+  session::AdmissionBudget b;
+  const bool software = renderer.find("llvmpipe") != std::string::npos ||
+                        renderer.find("softpipe") != std::string::npos;
+  if (config.max_pixel_rate_mpx > 0.0) {
+    b.max_pixel_rate = config.max_pixel_rate_mpx * 1e6;
+  } else if (config.max_pixel_rate_mpx == 0.0) {
+    b.max_pixel_rate = (software ? 60.0 : 2000.0) * 1e6;
+  }
+  if (config.max_memory_mb > 0.0) {
+    b.max_memory_bytes = config.max_memory_mb * 1024.0 * 1024.0;
+  } else if (config.max_memory_mb == 0.0) {
+    b.max_memory_bytes = available_memory_bytes() / 2.0;
+  }
+  return b;
+}
 
 std::optional<ServerConfig> parse_config(int argc, char** argv, int* exit_code) {
   ServerConfig c;
@@ -44,6 +119,49 @@ std::optional<ServerConfig> parse_config(int argc, char** argv, int* exit_code) 
       ->envname("DOWNPOUR_LOG_LEVEL");
   app.add_option("--stats-interval", c.stats_interval_s, "seconds between stats lines in the log")
       ->check(CLI::Range(1.0, 3600.0));
+  app.add_option("--session-idle-timeout-s", c.session_idle_timeout_s,
+                 "close a session no client has been heard for (no request, no Drive stream) "
+                 "this long; 0 = never")
+      ->check(CLI::Range(0.0, 86400.0))
+      ->envname("DOWNPOUR_SESSION_IDLE_TIMEOUT_S");
+  app.add_option("--shutdown-grace-s", c.shutdown_grace_s,
+                 "on SIGTERM, answer the steps in flight and exit within this many seconds")
+      ->check(CLI::Range(1.0, 3600.0))
+      ->envname("DOWNPOUR_SHUTDOWN_GRACE_S");
+  app.add_option(
+         "--max-pixel-rate-mpx", c.max_pixel_rate_mpx,
+         "budget of pixels per second (Mpx/s) over all sessions' views; a session that "
+         "would pass it is refused. 0 = by renderer (60 on llvmpipe, 2000 on a GPU), a negative "
+         "value = none")
+      ->check(CLI::Range(-1.0, 1e6))
+      ->envname("DOWNPOUR_MAX_PIXEL_RATE_MPX");
+  app.add_option("--max-memory-mb", c.max_memory_mb,
+                 "budget of the sessions' estimated memory (MiB). 0 = half of the machine's (or "
+                 "the container's) memory, a negative value = none")
+      ->check(CLI::Range(-1.0, 1e8))
+      ->envname("DOWNPOUR_MAX_MEMORY_MB");
+  app.add_option("--watchdog-s", c.watchdog_s,
+                 "health turns NOT_SERVING while the render loop has not come round for this "
+                 "long (a hung GPU, a frame far over its budget); 0 = off")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->envname("DOWNPOUR_WATCHDOG_S");
+  app.add_option("--tokens-file", c.tokens_file,
+                 "bearer tokens with their principals and roles, one per line: token principal "
+                 "driver|viewer|admin[,...]; without it every client may do everything")
+      ->envname("DOWNPOUR_TOKENS_FILE");
+  app.add_option("--tls-cert", c.tls_cert, "PEM certificate chain: serve TLS")
+      ->envname("DOWNPOUR_TLS_CERT");
+  app.add_option("--tls-key", c.tls_key, "PEM private key of --tls-cert")
+      ->envname("DOWNPOUR_TLS_KEY");
+  app.add_option("--tls-client-ca", c.tls_client_ca,
+                 "PEM CA certificates: require client certificates they sign (mutual TLS)")
+      ->envname("DOWNPOUR_TLS_CLIENT_CA");
+  app.add_flag("--allow-insecure-remote", c.allow_insecure_remote,
+               "listen beyond loopback without TLS and tokens (a network you trust)")
+      ->envname("DOWNPOUR_ALLOW_INSECURE_REMOTE");
+  app.add_option("--health-listen", c.health_listen,
+                 "also serve grpc.health.v1 alone, in plaintext, here (for probes without TLS)")
+      ->envname("DOWNPOUR_HEALTH_LISTEN");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

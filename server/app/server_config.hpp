@@ -2,10 +2,14 @@
 // variable (DOWNPOUR_<FLAG>) for containers.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 
+#include <grpcpp/security/server_credentials.h>
+
 #include "server/render/egl_context.hpp"
+#include "server/session/admission.hpp"
 
 namespace downpour::app {
 
@@ -21,9 +25,41 @@ struct ServerConfig {
   render::EglPlatformChoice renderer = render::EglPlatformChoice::kAuto;
   std::string log_level = "info";
   double stats_interval_s = 30.0;
+  // A session whose clients have all gone quiet (no request, no Drive stream) this long is
+  // closed, so a crashed simulator does not hold a session slot forever; 0 = never.
+  double session_idle_timeout_s = 60.0;
+  // SIGTERM drains: steps already accepted are answered, then streams end with UNAVAILABLE; the
+  // process exits within this many seconds (the deploy files' stop timeout).
+  double shutdown_grace_s = 30.0;
+  // Admission budgets (server/session/admission.hpp): 0 = sized for the renderer and the machine
+  // at start-up, -1 = none.
+  double max_pixel_rate_mpx = 0.0;
+  double max_memory_mb = 0.0;
+  // Health turns NOT_SERVING while the render loop has not come round for this long; 0 = off.
+  double watchdog_s = 10.0;
+  // Security (README, Exposing the server). A listen address other than loopback needs TLS and a
+  // tokens file, unless allow_insecure_remote says otherwise.
+  std::string tokens_file;    // bearer tokens, principals and roles (rpc/auth.hpp)
+  std::string tls_cert;       // PEM: the server's certificate chain ...
+  std::string tls_key;        // ... and its private key
+  std::string tls_client_ca;  // PEM: require client certificates signed by these (mutual TLS)
+  bool allow_insecure_remote = false;
+  // A plaintext listener with the health service alone, for probes that cannot speak TLS
+  // (Kubernetes' gRPC probes); empty = none.
+  std::string health_listen;
 };
 
 // Parses argv; on --help or an error returns the exit code to use instead of a config.
 std::optional<ServerConfig> parse_config(int argc, char** argv, int* exit_code);
+
+// Why this configuration may not start (a remote listener without TLS and tokens, half a TLS
+// pair), or empty.
+std::string security_problem(const ServerConfig& config);
+// TLS (mutual with a client CA) when configured, else plaintext; throws if a file is unreadable.
+std::shared_ptr<grpc::ServerCredentials> server_credentials(const ServerConfig& config);
+
+// The budgets the flags ask for, the automatic ones sized for the renderer (its GL_RENDERER
+// string: llvmpipe renders about 14 Mpx/s on two cores) and the memory this process may use.
+session::AdmissionBudget admission_budget(const ServerConfig& config, const std::string& renderer);
 
 }  // namespace downpour::app

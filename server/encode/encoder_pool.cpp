@@ -60,6 +60,14 @@ std::vector<std::uint8_t> EncoderPool::take_buffer(std::size_t bytes) {
   return std::vector<std::uint8_t>(bytes);
 }
 
+void EncoderPool::release_spare_buffers() {
+  std::vector<std::vector<std::uint8_t>> spare;
+  {
+    std::lock_guard lock(mutex_);
+    spare.swap(spare_buffers_);
+  }
+}
+
 void EncoderPool::run() {
   JpegEncoder encoder;
   for (;;) {

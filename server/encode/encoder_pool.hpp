@@ -42,6 +42,8 @@ class EncoderPool {
   int threads() const { return static_cast<int>(workers_.size()); }
   // Pixel buffers come back here after encoding, so that steady state allocates none.
   std::vector<std::uint8_t> take_buffer(std::size_t bytes);
+  // Frees the buffers kept for reuse (after sessions close: their sizes may not come back).
+  void release_spare_buffers();
 
  private:
   void run();

@@ -7,6 +7,8 @@
 #include <glm/exponential.hpp>
 #include <glm/trigonometric.hpp>
 
+#include "server/sim/rain_field.hpp"
+
 namespace downpour::render {
 
 Atmosphere atmosphere_from(const sim::Weather& w) {
@@ -44,11 +46,17 @@ Atmosphere atmosphere_from(const sim::Weather& w) {
                    glm::smoothstep(0.0f, 0.1f, sun_up);
   a.ambient = glm::mix(a.sky_zenith, a.sky_horizon, 0.5f) * 0.9f;
 
-  // Extinction: clear air sees kilometres; rain and fog bring the horizon in.
-  a.fog_density = 0.00012f + static_cast<float>(w.fog_density) * 0.012f + rain * 0.00004f;
+  // Extinction: clear air sees kilometres; fog and rain bring the horizon in (the rain's from its
+  // drop sizes, sim/rain_field.hpp: 2.5 km of visibility at 10 mm/h, 930 m at 50).
+  a.fog_density = 0.00012f + static_cast<float>(w.fog_density) * 0.012f +
+                  static_cast<float>(sim::rain_extinction_per_m(w.rain_rate_mm_h));
   a.fog_colour = a.sky_horizon;
   a.wetness = std::clamp(rain / 5.0f, 0.0f, 1.0f);
   return a;
+}
+
+double visibility_m(const Atmosphere& atmosphere) {
+  return sim::visibility_m(atmosphere.fog_density);
 }
 
 }  // namespace downpour::render

@@ -21,5 +21,7 @@ struct Atmosphere {
 };
 
 Atmosphere atmosphere_from(const sim::Weather& weather);
+// The meteorological visibility (m) through this air: 2% contrast left (Koschmieder).
+double visibility_m(const Atmosphere& atmosphere);
 
 }  // namespace downpour::render

@@ -1,5 +1,6 @@
 #include "server/render/camera.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/trigonometric.hpp>
@@ -8,6 +9,14 @@
 #include "server/sim/pose.hpp"
 
 namespace downpour::render {
+namespace {
+
+constexpr double kEyeFocusM = 20.0;  // the road ahead
+constexpr double kEyePupilMm = 4.0;  // an overcast day
+constexpr double kCameraFocusM = 3.0;
+constexpr double kCameraApertureMm = 2.0;
+
+}  // namespace
 
 sim::CameraPose default_camera_pose(sim::View view) {
   switch (view) {
@@ -33,9 +42,17 @@ Camera make_camera(const sim::ViewSpec& spec, const sim::VehicleState& vehicle) 
 
   Camera c;
   c.fov_y_deg = static_cast<float>(spec.fov_deg > 0.0 ? spec.fov_deg : default_fov_deg(spec.view));
+  c.position_vehicle = pose.position_m;
+  c.axes_vehicle = sim::rotation_matrix(pose.rotation);
+  c.tan_half_fov_y = std::tan(glm::radians(static_cast<double>(c.fov_y_deg)) * 0.5);
+  c.tan_half_fov_x = c.tan_half_fov_y * spec.width / std::max(spec.height, 1);
+  // The eye focuses on the road through its pupil; a camera of its own sees the glass's water
+  // sharper (a small lens focused nearer).
+  c.focus_m = spec.focus_distance_m.value_or(spec.camera ? kCameraFocusM : kEyeFocusM);
+  c.aperture_mm = spec.aperture_mm.value_or(spec.camera ? kCameraApertureMm : kEyePupilMm);
   c.position = glm::vec3(cam_to_world[3]);
   // A camera in the cabin may sit a few centimetres from the raked glass.
-  if (spec.view == sim::View::kCockpit) c.near_m = 0.01f;
+  if (spec.view == sim::View::kCockpit || spec.view == sim::View::kRain) c.near_m = 0.01f;
   c.view = glm::mat4(glm::inverse(cam_to_world));
   // Reversed-Z with an infinite far plane (clip control zero-to-one, depth test GREATER, clear 0):
   // float depth keeps its precision from the dashboard at 0.3 m to hills kilometres away.

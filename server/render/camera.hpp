@@ -1,6 +1,8 @@
-// Cameras of the views, placed in the vehicle frame: the driver's eye, the chase camera.
+// Cameras of the views, placed in the vehicle frame: the driver's eye, the chase camera, a dash
+// camera; and their lenses.
 #pragma once
 
+#include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
@@ -14,6 +16,14 @@ struct Camera {
   glm::vec3 position{0.0f};  // world
   float fov_y_deg = 60.0f;
   float near_m = 0.05f;
+  // The rig in the vehicle frame: position (m) and axes (columns: forward, left, up).
+  glm::dvec3 position_vehicle{0.0};
+  glm::dmat3 axes_vehicle{1.0};
+  double tan_half_fov_x = 0.0;
+  double tan_half_fov_y = 0.0;
+  // The lens: focus distance (m) and aperture diameter (mm); ViewSpec's or the view's default.
+  double focus_m = 20.0;
+  double aperture_mm = 4.0;
 };
 
 // Default poses and fields of view, vehicle frame.

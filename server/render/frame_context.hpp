@@ -1,40 +1,56 @@
-// What every pass sees of the frame it draws, and the GL resources the passes share.
+// What every pass sees of the frame it draws, the GL resources of the frame, and the resources the
+// passes share for the renderer's life.
 #pragma once
+
+#include <functional>
 
 #include <glm/mat4x4.hpp>
 
 #include "server/render/atmosphere.hpp"
 #include "server/render/camera.hpp"
 #include "server/render/gl_objects.hpp"
+#include "server/render/glass_view.hpp"
 #include "server/sim/simulation.hpp"
 #include "server/sim/track.hpp"
 
 namespace downpour::render {
 
 struct FrameContext {
+  // The simulator's inputs for this frame: pose, weather, traffic, the time after the step. Its
+  // `windshield` is not read here: the water may still be stepping on another thread.
   const sim::SceneState& scene;
   const sim::ViewSpec& spec;
   Camera camera;
   Atmosphere atmosphere;
   glm::mat4 vehicle_to_world{1.0f};
-  // The view's render target, bound while the passes draw: its framebuffer and attachments.
-  GLuint target_fbo = 0;
-  GLuint target_colour = 0;
-  GLuint target_depth = 0;
+  GlassView glass;  // where the view meets the windshield, and how sharply it sees the glass
+  // The state after this frame's step; waits for the step. Only passes that declare
+  // PassDecl::reads_step call it (through water() and rain()).
+  std::function<const sim::SceneState&()> stepped;
+
+  const sim::WindshieldState& water() const { return stepped().windshield; }
+  const sim::RainState& rain() const { return stepped().rain; }
 };
 
-// Texture units and the uniform block binding fixed across the shaders (common.glsl).
-namespace binding {
-inline constexpr GLuint kFrameBlock = 0;
-inline constexpr GLuint kNoise = 1;
-inline constexpr GLuint kAsphalt = 2;
-inline constexpr GLuint kMetaballDensity = 3;
-inline constexpr GLuint kWaterHeights = 4;
-inline constexpr GLuint kWaterMap = 5;
-inline constexpr GLuint kSceneBlur = 6;
-inline constexpr GLuint kViewColour = 7;
-inline constexpr GLuint kViewDepth = 8;
-}  // namespace binding
+// A texture the passes draw into or read, with its size.
+struct TargetTexture {
+  GLuint texture = 0;
+  int width = 0;
+  int height = 0;
+};
+
+// The frame's resources by name (pass.hpp's Resource): the renderer binds the framebuffer a pass
+// writes and the textures it reads before the pass runs.
+struct FrameResources {
+  GLuint view_fbo = 0;
+  TargetTexture view_colour;
+  TargetTexture view_depth;
+  GLuint scene_blur_fbo = 0;
+  TargetTexture scene_blur;
+  GLuint glass_layer_fbo = 0;
+  TargetTexture glass_layer;
+  TargetTexture glass_water;  // the session's glass water map
+};
 
 // Resources made once and shared by the passes.
 struct SharedResources {

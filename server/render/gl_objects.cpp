@@ -1,43 +1,19 @@
 #include "server/render/gl_objects.hpp"
 
-#include <map>
-#include <sstream>
 #include <stdexcept>
-#include <string_view>
 
 #include <glm/gtc/type_ptr.hpp>
 
-namespace downpour::render {
+#include "server/render/shader_source.hpp"
 
-const std::map<std::string, std::string_view>& embedded_shaders();  // generated at build time
+namespace downpour::render {
 
 namespace {
 
-std::string shader_source(const std::string& file, int depth = 0) {
-  const auto& shaders = embedded_shaders();
-  const auto it = shaders.find(file);
-  if (it == shaders.end()) throw std::runtime_error("no embedded shader named " + file);
-  if (depth > 4) throw std::runtime_error("shader includes nest too deep at " + file);
-  std::istringstream in{std::string(it->second)};
-  std::ostringstream out;
-  std::string line;
-  while (std::getline(in, line)) {
-    const std::string directive = "#include \"";
-    if (line.rfind(directive, 0) == 0) {
-      const auto end = line.find('"', directive.size());
-      out << shader_source(line.substr(directive.size(), end - directive.size()), depth + 1)
-          << "\n";
-    } else {
-      out << line << "\n";
-    }
-  }
-  return out.str();
-}
-
 GLuint compile(GLenum stage, const std::string& file) {
-  const std::string source = shader_source(file);
+  const ShaderSource source = resolve_shader(file);
   const GLuint shader = glCreateShader(stage);
-  const char* text = source.c_str();
+  const char* text = source.text.c_str();
   glShaderSource(shader, 1, &text, nullptr);
   glCompileShader(shader);
   GLint ok = 0;
@@ -46,7 +22,7 @@ GLuint compile(GLenum stage, const std::string& file) {
     char log[4096];
     glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
     glDeleteShader(shader);
-    throw std::runtime_error("compiling " + file + ": " + log);
+    throw std::runtime_error("compiling " + file + ": " + name_files_in_log(log, source));
   }
   return shader;
 }
@@ -62,7 +38,8 @@ Texture make_texture_2d(GLenum internal_format, int width, int height, int level
   return Texture(id);
 }
 
-ShaderProgram::ShaderProgram(const std::string& vertex_file, const std::string& fragment_file) {
+ShaderProgram::ShaderProgram(const std::string& vertex_file, const std::string& fragment_file)
+    : files_(vertex_file + " + " + fragment_file) {
   const GLuint vs = compile(GL_VERTEX_SHADER, vertex_file);
   GLuint fs = 0;
   try {
@@ -83,20 +60,18 @@ ShaderProgram::ShaderProgram(const std::string& vertex_file, const std::string& 
   if (!ok) {
     char log[4096];
     glGetProgramInfoLog(program, sizeof(log), nullptr, log);
-    throw std::runtime_error("linking " + vertex_file + " + " + fragment_file + ": " + log);
+    throw std::runtime_error("linking " + files_ + ": " + log);
   }
 }
 
-GLint ShaderProgram::location(const char* name) {
-  const auto it = locations_.find(name);
-  if (it != locations_.end()) return it->second;
-  const GLint loc = glGetUniformLocation(program_.id(), name);
-  locations_.emplace(name, loc);
-  return loc;
+Uniform ShaderProgram::uniform(const char* name) const {
+  const GLint location = glGetUniformLocation(program_.id(), name);
+  if (location < 0) throw std::logic_error(files_ + " has no active uniform " + name);
+  return Uniform(program_.id(), location);
 }
 
-void ShaderProgram::set(const char* name, const glm::mat4& m) {
-  glProgramUniformMatrix4fv(program_.id(), location(name), 1, GL_FALSE, glm::value_ptr(m));
+void Uniform::set(const glm::mat4& m) const {
+  glProgramUniformMatrix4fv(program_, location_, 1, GL_FALSE, glm::value_ptr(m));
 }
 
 Mesh::Mesh(const MeshData& data)

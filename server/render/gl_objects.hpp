@@ -4,7 +4,6 @@
 
 #include <cstdint>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include <glm/mat4x4.hpp>
@@ -56,30 +55,37 @@ using VertexArray = GlName<gl_delete::vertex_array>;
 
 Texture make_texture_2d(GLenum internal_format, int width, int height, int levels = 1);
 
-// A linked program from embedded shader files (by file name, e.g. "sky.frag"). Files may start
-// with `#include "common.glsl"` lines, resolved from the embedded set. Throws with the GL log.
+// A uniform's location in a program, looked up once (when the pass is made) and set by handle.
+class Uniform {
+ public:
+  Uniform() = default;
+  Uniform(GLuint program, GLint location) : program_(program), location_(location) {}
+  void set(float v) const { glProgramUniform1f(program_, location_, v); }
+  void set(int v) const { glProgramUniform1i(program_, location_, v); }
+  void set(glm::vec2 v) const { glProgramUniform2f(program_, location_, v.x, v.y); }
+  void set(glm::vec3 v) const { glProgramUniform3f(program_, location_, v.x, v.y, v.z); }
+  void set(glm::vec4 v) const { glProgramUniform4f(program_, location_, v.x, v.y, v.z, v.w); }
+  void set(const glm::mat4& m) const;
+
+ private:
+  GLuint program_ = 0;
+  GLint location_ = -1;  // -1 (not in the program) makes set() a no-op, as GL defines
+};
+
+// A linked program from embedded shader files (by file name, e.g. "sky.frag"), their
+// `#include "x.glsl"` lines resolved (shader_source.hpp). Throws with the driver's log, its
+// locations named by file.
 class ShaderProgram {
  public:
   ShaderProgram(const std::string& vertex_file, const std::string& fragment_file);
   void use() const { glUseProgram(program_.id()); }
-  GLint location(const char* name);
-
-  void set(const char* name, float v) { glProgramUniform1f(program_.id(), location(name), v); }
-  void set(const char* name, int v) { glProgramUniform1i(program_.id(), location(name), v); }
-  void set(const char* name, glm::vec2 v) {
-    glProgramUniform2f(program_.id(), location(name), v.x, v.y);
-  }
-  void set(const char* name, glm::vec3 v) {
-    glProgramUniform3f(program_.id(), location(name), v.x, v.y, v.z);
-  }
-  void set(const char* name, glm::vec4 v) {
-    glProgramUniform4f(program_.id(), location(name), v.x, v.y, v.z, v.w);
-  }
-  void set(const char* name, const glm::mat4& m);
+  // Throws std::logic_error if the program has no such active uniform: a misspelt name fails at
+  // start-up, not silently.
+  Uniform uniform(const char* name) const;
 
  private:
+  std::string files_;
   GlName<gl_delete::program> program_;
-  std::unordered_map<std::string, GLint> locations_;
 };
 
 // A static indexed triangle mesh, uploaded from MeshData (attributes 0 position, 1 normal, 2 uv),
@@ -90,6 +96,7 @@ class Mesh {
   explicit Mesh(const MeshData& data);
   void draw() const;
   bool empty() const { return index_count_ == 0; }
+  std::size_t triangles() const { return static_cast<std::size_t>(index_count_) / 3; }
   glm::vec3 bounds_min{0.0f};
   glm::vec3 bounds_max{0.0f};
 

@@ -1,43 +1,41 @@
 #include "server/render/renderer.hpp"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <stdexcept>
+#include <tuple>
 
-#include <glm/gtc/type_ptr.hpp>
+#include <spdlog/spdlog.h>
+#include <glm/trigonometric.hpp>
 
 #include "server/render/frame_context.hpp"
+#include "server/render/pass.hpp"
 #include "server/render/passes/cockpit_pass.hpp"
+#include "server/render/passes/glass_background_pass.hpp"
+#include "server/render/passes/glass_composite_pass.hpp"
+#include "server/render/passes/glass_water_pass.hpp"
+#include "server/render/passes/rain_pass.hpp"
 #include "server/render/passes/road_pass.hpp"
 #include "server/render/passes/sky_pass.hpp"
 #include "server/render/passes/terrain_pass.hpp"
 #include "server/render/passes/vehicle_pass.hpp"
-#include "server/render/passes/windshield_glass_pass.hpp"
 #include "server/render/passes/windshield_pass.hpp"
-#include "server/render/passes/windshield_water_pass.hpp"
 #include "server/render/procedural_textures.hpp"
+#include "server/render/shader_interface.hpp"
 #include "server/sim/pose.hpp"
 
 namespace downpour::render {
 namespace {
 
 constexpr int kReadbackSlots = 2;
-
-// The std140 uniform block `FrameBlock` of common.glsl.
-struct FrameBlock {
-  glm::mat4 view_proj;
-  glm::mat4 inv_view_proj;
-  glm::vec4 camera_pos;
-  glm::vec4 sun_dir;
-  glm::vec4 sun_radiance;
-  glm::vec4 sky_zenith;
-  glm::vec4 sky_horizon;
-  glm::vec4 ambient;
-  glm::vec4 fog;     // rgb colour, a extinction per metre
-  glm::vec4 params;  // x sim time, y overcast, z wetness, w rain rate (mm/h)
-  glm::vec4 wind;    // xy wind velocity (m/s, world)
-};
+constexpr int kSceneBlurScale = 8;  // the refraction background's size, 1 / 8 of the view
+constexpr std::size_t kMaxTransients = 12;
+constexpr std::chrono::seconds kFenceDeadline{10};
 
 Texture upload_repeating(const Image8& image, bool mipmaps) {
   int levels = 1;
@@ -53,26 +51,33 @@ Texture upload_repeating(const Image8& image, bool mipmaps) {
   return t;
 }
 
+Framebuffer framebuffer_with(GLuint colour, GLuint depth) {
+  GLuint fb = 0;
+  glCreateFramebuffers(1, &fb);
+  Framebuffer fbo(fb);
+  if (colour) glNamedFramebufferTexture(fb, GL_COLOR_ATTACHMENT0, colour, 0);
+  if (depth) glNamedFramebufferTexture(fb, GL_DEPTH_ATTACHMENT, depth, 0);
+  if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    throw std::runtime_error("render target framebuffer incomplete");
+  }
+  return fbo;
+}
+
+// A view's colour and depth, and its readback buffers.
 struct ViewTarget {
   int width = 0;
   int height = 0;
   Texture colour;
   Texture depth;
   Framebuffer fbo;
-  Buffer pbo[kReadbackSlots];
+  std::array<Buffer, kReadbackSlots> pbo;
+  std::array<GLsync, kReadbackSlots> fence{};  // a readback in flight per slot
   int next_slot = 0;
 
   ViewTarget(int w, int h) : width(w), height(h) {
     colour = make_texture_2d(GL_RGBA8, w, h);
     depth = make_texture_2d(GL_DEPTH_COMPONENT32F, w, h);
-    GLuint fb = 0;
-    glCreateFramebuffers(1, &fb);
-    fbo = Framebuffer(fb);
-    glNamedFramebufferTexture(fb, GL_COLOR_ATTACHMENT0, colour.id(), 0);
-    glNamedFramebufferTexture(fb, GL_DEPTH_ATTACHMENT, depth.id(), 0);
-    if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-      throw std::runtime_error("render target framebuffer incomplete");
-    }
+    fbo = framebuffer_with(colour.id(), depth.id());
     GLuint ids[kReadbackSlots];
     glCreateBuffers(kReadbackSlots, ids);
     for (int i = 0; i < kReadbackSlots; ++i) {
@@ -80,36 +85,85 @@ struct ViewTarget {
       glNamedBufferStorage(ids[i], static_cast<GLsizeiptr>(w) * h * 4, nullptr, GL_MAP_READ_BIT);
     }
   }
+  ~ViewTarget() {
+    for (GLsync f : fence) {
+      if (f) glDeleteSync(f);
+    }
+  }
+  bool busy() const {
+    return std::any_of(fence.begin(), fence.end(), [](GLsync f) { return f != nullptr; });
+  }
 };
 
+// A target that lives only within a frame (the scene blur, the glass layer), kept by size.
+struct Transient {
+  Texture texture;
+  Framebuffer fbo;
+  int width = 0;
+  int height = 0;
+  std::uint64_t last_frame = 0;  // the last frame that drew into it
+};
+
+GLuint unit_of(Resource r) {
+  switch (r) {
+    case Resource::kViewColour:
+      return texture_unit::kViewColour;
+    case Resource::kViewDepth:
+      return texture_unit::kViewDepth;
+    case Resource::kSceneBlur:
+      return texture_unit::kSceneBlur;
+    case Resource::kGlassLayer:
+      return texture_unit::kGlassLayer;
+    case Resource::kGlassWater:
+      return texture_unit::kGlassWater;
+  }
+  return 0;
+}
+
+bool is_view_target(Resource r) { return r == Resource::kViewColour || r == Resource::kViewDepth; }
+
 }  // namespace
+
+struct RenderSession::Impl {
+  std::vector<std::unique_ptr<ViewTarget>> views;
+  // The glass water map on the GPU and the content it holds.
+  Texture glass_water;
+  int water_width = 0;
+  int water_height = 0;
+  std::uint64_t water_stamp = 0;
+};
+
+RenderSession::RenderSession(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+RenderSession::~RenderSession() = default;
 
 struct Renderer::Impl {
   std::unique_ptr<EglContext> context;
   std::unique_ptr<SharedResources> shared;
   Buffer frame_ubo;
-  std::unique_ptr<SkyPass> sky;
-  std::unique_ptr<TerrainPass> terrain;
-  std::unique_ptr<RoadPass> road;
-  std::unique_ptr<VehiclePass> vehicles;
-  std::unique_ptr<CockpitPass> cockpit;
-  std::unique_ptr<WindshieldWaterPass> windshield_water;
-  std::unique_ptr<WindshieldGlassPass> windshield_glass;
-  std::unique_ptr<WindshieldPass> windshield;
-  std::map<std::uint64_t, std::unique_ptr<ViewTarget>> targets;
-  // A fence per target slot still being read back: a slot is reused only after finish().
-  std::map<std::pair<std::uint64_t, int>, GLsync> in_flight;
+  std::vector<std::unique_ptr<Pass>> passes;
+  std::array<std::vector<Pass*>, sim::kViewCount> views;  // each view's passes, in order
+  std::map<std::tuple<Resource, int, int>, Transient> transients;
   bool profiling = false;
   std::vector<PassTiming> timings;
+  std::uint64_t frame = 0;                       // frames rendered, for the transients' use
+  std::unique_ptr<RenderSession> image_session;  // render_image's
+  RainPass* rain = nullptr;                      // one of passes
+  std::uint32_t rain_streaks = 0;                // drawn by the last render()
 
   template <typename Fn>
-  void timed(const char* name, Fn&& fn) {
+  void timed(const std::string& name, Fn&& fn) {
     const auto t0 = std::chrono::steady_clock::now();
     fn();
     if (profiling) glFinish();
     timings.push_back(
         {name,
          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count()});
+  }
+
+  template <typename P>
+  P* add() {
+    passes.push_back(std::make_unique<P>(*shared));
+    return static_cast<P*>(passes.back().get());
   }
 
   void upload_frame_block(const FrameContext& f) {
@@ -131,77 +185,191 @@ struct Renderer::Impl {
     glNamedBufferSubData(frame_ubo.id(), 0, sizeof(b), &b);
   }
 
-  // The water maps in glass space for this view's size, then back to the view's target.
-  void draw_windshield_water(const FrameContext& f) {
-    const WaterMapLayout layout = water_map_layout(f, windshield_water->config());
-    timed("windshield_splat", [&] { windshield_water->splat(f.scene.windshield, layout); });
-    timed("windshield_compress", [&] { windshield_water->compress(); });
-    glBindFramebuffer(GL_FRAMEBUFFER, f.target_fbo);
-    glViewport(0, 0, f.spec.width, f.spec.height);
+  Transient& transient(Resource r, int width, int height) {
+    const auto key = std::make_tuple(r, width, height);
+    auto it = transients.find(key);
+    if (it != transients.end()) {
+      it->second.last_frame = frame;
+      return it->second;
+    }
+    Transient t;
+    t.last_frame = frame;
+    t.width = width;
+    t.height = height;
+    if (r == Resource::kSceneBlur) {
+      t.texture = make_texture_2d(GL_RGBA8, width, height);
+      glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_S, GL_MIRRORED_REPEAT);
+      glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_T, GL_MIRRORED_REPEAT);
+    } else {
+      t.texture = make_texture_2d(GL_RGBA8, width, height);
+      glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+    t.fbo = framebuffer_with(t.texture.id(), 0);
+    return transients.emplace(key, std::move(t)).first->second;
   }
 
-  void draw_view(const FrameContext& f) {
-    switch (f.spec.view) {
-      case sim::View::kCockpit:
-      case sim::View::kRoad:
-        // Nearest first, sky last: llvmpipe tests depth before shading, so what is hidden costs
-        // little, and the sky shades only the pixels left empty.
-        glEnable(GL_DEPTH_TEST);
-        if (f.spec.view == sim::View::kCockpit) timed("cockpit", [&] { cockpit->draw(f); });
-        timed("vehicles", [&] { vehicles->draw(f); });
-        timed("road", [&] { road->draw(f); });
-        timed("terrain", [&] { terrain->draw(f); });
-        timed("sky", [&] { sky->draw(f); });
-        if (f.spec.view == sim::View::kCockpit) {
-          timed("windshield_scene_copy", [&] { windshield_glass->copy_scene(f); });
-          draw_windshield_water(f);
-          timed("windshield_glass", [&] { windshield_glass->draw(f, *windshield_water); });
-        }
-        break;
-      case sim::View::kWindshield:
-        draw_windshield_water(f);
-        timed("windshield", [&] { windshield->draw(f, *windshield_water); });
-        break;
-      case sim::View::kRain:
-        break;  // the rain layer over black: streaks and spray come with their passes
+  // Many view sizes at once are rare: past kMaxTransients, the targets unused the longest go (at
+  // a frame's start, so never one a pass of this frame has bound).
+  void evict_transients() {
+    while (transients.size() > kMaxTransients) {
+      auto oldest = transients.begin();
+      for (auto it = transients.begin(); it != transients.end(); ++it) {
+        if (it->second.last_frame < oldest->second.last_frame) oldest = it;
+      }
+      transients.erase(oldest);
     }
   }
+
+  // The session's glass water map brought up to this frame's: the rows that changed when the
+  // texture holds the previous frame's map, else the whole map.
+  void upload_glass_water(RenderSession::Impl& s, const sim::GlassWaterMap& map) {
+    if (map.width <= 0 || map.height <= 0 ||
+        map.rgba.size() < static_cast<std::size_t>(map.width) * map.height * 4) {
+      // No map (a scene made without a simulation): one texel of dry glass.
+      static const sim::GlassWaterMap dry{1, 1, 1.0, {128, 128, 0, 0}};
+      if (&map != &dry) upload_glass_water(s, dry);
+      return;
+    }
+    if (s.water_stamp == map.stamp && s.water_width == map.width && s.water_height == map.height)
+      return;
+    int first = 0, last = map.height;
+    if (!s.glass_water.id() || s.water_width != map.width || s.water_height != map.height) {
+      s.glass_water = make_texture_2d(GL_RGBA8, map.width, map.height);
+      glTextureParameteri(s.glass_water.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTextureParameteri(s.glass_water.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      s.water_width = map.width;
+      s.water_height = map.height;
+    } else if (s.water_stamp != 0 && s.water_stamp == map.previous_stamp) {
+      first = std::clamp(map.dirty_row_begin, 0, map.height);
+      last = std::clamp(map.dirty_row_end, first, map.height);
+    }
+    if (last > first) {
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+      glTextureSubImage2D(s.glass_water.id(), 0, 0, first, map.width, last - first, GL_RGBA,
+                          GL_UNSIGNED_BYTE,
+                          map.rgba.data() + static_cast<std::size_t>(first) * map.width * 4);
+    }
+    s.water_stamp = map.stamp;
+  }
+
+  void run_pass(Pass& pass, const FrameContext& f, RenderSession::Impl& session,
+                FrameResources& r) {
+    if (!pass.wanted(f)) return;
+    const PassDecl& d = pass.decl();
+    // A transient that no pass of this frame drew (its pass had nothing to draw) leaves its
+    // readers nothing to draw either.
+    for (Resource res : d.reads) {
+      if ((res == Resource::kSceneBlur || res == Resource::kGlassLayer) && !written[index(res)])
+        return;
+    }
+    for (Resource res : d.reads) {
+      GLuint texture = 0;
+      switch (res) {
+        case Resource::kViewColour:
+          texture = r.view_colour.texture;
+          break;
+        case Resource::kViewDepth:
+          texture = r.view_depth.texture;
+          break;
+        case Resource::kSceneBlur:
+          texture = r.scene_blur.texture;
+          break;
+        case Resource::kGlassLayer:
+          texture = r.glass_layer.texture;
+          break;
+        case Resource::kGlassWater:
+          upload_glass_water(session, f.water().map);
+          r.glass_water = {session.glass_water.id(), session.water_width, session.water_height};
+          texture = r.glass_water.texture;
+          break;
+      }
+      glBindTextureUnit(unit_of(res), texture);
+    }
+    const Resource out = d.writes.front();
+    if (is_view_target(out)) {
+      glBindFramebuffer(GL_FRAMEBUFFER, r.view_fbo);
+      glViewport(0, 0, r.view_colour.width, r.view_colour.height);
+    } else {
+      const int w = r.view_colour.width, h = r.view_colour.height;
+      const int scale = out == Resource::kSceneBlur ? kSceneBlurScale : f.glass.layer_scale();
+      Transient& t = transient(out, std::max(1, (w + scale - 1) / scale),
+                               std::max(1, (h + scale - 1) / scale));
+      (out == Resource::kSceneBlur ? r.scene_blur : r.glass_layer) = {t.texture.id(), t.width,
+                                                                      t.height};
+      (out == Resource::kSceneBlur ? r.scene_blur_fbo : r.glass_layer_fbo) = t.fbo.id();
+      glBindFramebuffer(GL_FRAMEBUFFER, t.fbo.id());
+      glViewport(0, 0, t.width, t.height);
+      const float clear[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+      glClearNamedFramebufferfv(t.fbo.id(), GL_COLOR, 0, clear);
+    }
+    apply(d.state);
+    pass.execute(f, r);
+    for (Resource res : d.writes) written[index(res)] = true;
+  }
+
+  static std::size_t index(Resource r) { return static_cast<std::size_t>(r); }
+  std::array<bool, kResourceCount> written{};  // this frame's
 };
 
 Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
-Renderer::~Renderer() {
-  for (auto& [key, fence] : impl_->in_flight) glDeleteSync(fence);
-}
+Renderer::~Renderer() = default;
 
 std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   auto impl = std::make_unique<Impl>();
   impl->context = EglContext::create(options.platform);
+#ifndef NDEBUG
+  // Debug builds: the driver's own reports of errors and misuse, in the log as they happen.
+  glEnable(GL_DEBUG_OUTPUT);
+  glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
+  glDebugMessageCallback(
+      [](GLenum, GLenum type, GLuint id, GLenum severity, GLsizei, const GLchar* message,
+         const void*) {
+        if (severity == GL_DEBUG_SEVERITY_NOTIFICATION) return;
+        spdlog::log(type == GL_DEBUG_TYPE_ERROR ? spdlog::level::err : spdlog::level::warn,
+                    "GL debug {}: {}", id, message);
+      },
+      nullptr);
+#endif
   // Reversed-Z: depth 1 at the near plane, 0 at infinity (see camera.cpp).
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-  glDepthFunc(GL_GREATER);
   glClearDepthf(0.0f);
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
 
   impl->shared = std::make_unique<SharedResources>(
       SharedResources{sim::Track::test_track(), upload_repeating(make_noise(256, 1), true),
                       upload_repeating(make_asphalt_relief(512, 2), true), FullscreenTriangle()});
-  glBindTextureUnit(binding::kNoise, impl->shared->noise.id());
-  glBindTextureUnit(binding::kAsphalt, impl->shared->asphalt.id());
+  glBindTextureUnit(texture_unit::kNoise, impl->shared->noise.id());
+  glBindTextureUnit(texture_unit::kAsphalt, impl->shared->asphalt.id());
   GLuint ubo = 0;
   glCreateBuffers(1, &ubo);
   impl->frame_ubo = Buffer(ubo);
   glNamedBufferStorage(ubo, sizeof(FrameBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
-  glBindBufferBase(GL_UNIFORM_BUFFER, binding::kFrameBlock, ubo);
+  glBindBufferBase(GL_UNIFORM_BUFFER, kFrameBlockBinding, ubo);
 
-  SharedResources& s = *impl->shared;
-  impl->sky = std::make_unique<SkyPass>(s);
-  impl->terrain = std::make_unique<TerrainPass>(s);
-  impl->road = std::make_unique<RoadPass>(s);
-  impl->vehicles = std::make_unique<VehiclePass>(s);
-  impl->cockpit = std::make_unique<CockpitPass>(s);
-  impl->windshield_water = std::make_unique<WindshieldWaterPass>();
-  impl->windshield_glass = std::make_unique<WindshieldGlassPass>(s);
-  impl->windshield = std::make_unique<WindshieldPass>(s);
+  // The views as lists of passes. Nearest first, sky last: llvmpipe tests depth before shading,
+  // so what is hidden costs little, and the sky shades only the pixels left empty.
+  Pass* cockpit = impl->add<CockpitPass>();
+  Pass* vehicles = impl->add<VehiclePass>();
+  Pass* road = impl->add<RoadPass>();
+  Pass* terrain = impl->add<TerrainPass>();
+  Pass* sky = impl->add<SkyPass>();
+  RainPass* rain = impl->add<RainPass>();
+  impl->rain = rain;
+  Pass* rain_mask = impl->add<RainMaskPass>();
+  Pass* glass_background = impl->add<GlassBackgroundPass>();
+  Pass* glass_water = impl->add<GlassWaterPass>();
+  Pass* glass_composite = impl->add<GlassCompositePass>();
+  Pass* windshield = impl->add<WindshieldPass>();
+  auto& views = impl->views;
+  views[static_cast<int>(sim::View::kCockpit)] = {
+      cockpit, vehicles, road, terrain, sky, rain, glass_background, glass_water, glass_composite};
+  views[static_cast<int>(sim::View::kRoad)] = {vehicles, road, terrain, sky, rain};
+  views[static_cast<int>(sim::View::kWindshield)] = {windshield};
+  // The rain layer alone from the driver's eye: the scene for its depth, then black, then rain.
+  views[static_cast<int>(sim::View::kRain)] = {cockpit, vehicles, road, terrain, rain_mask, rain};
+  for (int v = 0; v < sim::kViewCount; ++v)
+    check_pass_order(sim::view_name(static_cast<sim::View>(v)), views[v]);
   if (glGetError() != GL_NO_ERROR) throw std::runtime_error("GL error while creating the renderer");
   return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
 }
@@ -210,50 +378,89 @@ const std::string& Renderer::gl_renderer() const { return impl_->context->render
 const std::string& Renderer::platform() const { return impl_->context->platform(); }
 void Renderer::set_profiling(bool on) { impl_->profiling = on; }
 const std::vector<PassTiming>& Renderer::last_pass_timings() const { return impl_->timings; }
+std::uint32_t Renderer::last_rain_streaks() const { return impl_->rain_streaks; }
 
-PendingReadback Renderer::render(std::uint64_t key, const sim::ViewSpec& spec,
+void Renderer::release_shared_targets() { impl_->transients.clear(); }
+
+std::unique_ptr<RenderSession> Renderer::open_session() {
+  return std::unique_ptr<RenderSession>(new RenderSession(std::make_unique<RenderSession::Impl>()));
+}
+
+PendingReadback Renderer::render(RenderSession& session, int view_index, const sim::ViewSpec& spec,
                                  const sim::SceneState& scene) {
+  return render(session, view_index, spec, scene,
+                [&scene]() -> const sim::SceneState& { return scene; });
+}
+
+PendingReadback Renderer::render(RenderSession& session, int view_index, const sim::ViewSpec& spec,
+                                 const sim::SceneState& scene, const StepSource& stepped) {
   Impl& m = *impl_;
+  RenderSession::Impl& s = *session.impl_;
   m.timings.clear();
-  auto& target = m.targets[key];
+  if (view_index < 0) throw std::logic_error("negative view index");
+  if (s.views.size() <= static_cast<std::size_t>(view_index)) s.views.resize(view_index + 1);
+  auto& target = s.views[view_index];
   if (!target || target->width != spec.width || target->height != spec.height) {
-    for (int slot = 0; slot < kReadbackSlots; ++slot) {
-      if (m.in_flight.count({key, slot}))
-        throw std::logic_error("render target resized with a readback in flight");
-    }
+    if (target && target->busy())
+      throw std::logic_error("render target resized with a readback in flight");
     target = std::make_unique<ViewTarget>(spec.width, spec.height);
   }
   const int slot = target->next_slot;
   target->next_slot = (slot + 1) % kReadbackSlots;
-  if (m.in_flight.count({key, slot}))
-    throw std::logic_error("readback slot reused before finish()");
+  if (target->fence[slot]) throw std::logic_error("readback slot reused before finish()");
 
+  const Camera camera = make_camera(spec, scene.vehicle);
   FrameContext frame{scene,
                      spec,
-                     make_camera(spec, scene.vehicle),
+                     camera,
                      atmosphere_from(scene.weather),
                      glm::mat4(sim::vehicle_to_world(scene.vehicle)),
-                     target->fbo.id(),
-                     target->colour.id(),
-                     target->depth.id()};
+                     GlassView(camera, scene.glass, spec.height),
+                     stepped};
+  FrameResources resources;
+  resources.view_fbo = target->fbo.id();
+  resources.view_colour = {target->colour.id(), spec.width, spec.height};
+  resources.view_depth = {target->depth.id(), spec.width, spec.height};
   glBindFramebuffer(GL_FRAMEBUFFER, target->fbo.id());
   glViewport(0, 0, spec.width, spec.height);
+  apply(RenderState{DepthTest::kOff, true, Blend::kOff});  // clears obey the depth mask
   const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
   const float zero_depth = 0.0f;
   glClearNamedFramebufferfv(target->fbo.id(), GL_COLOR, 0, black);
   glClearNamedFramebufferfv(target->fbo.id(), GL_DEPTH, 0, &zero_depth);
   m.upload_frame_block(frame);
-  m.draw_view(frame);
+  ++m.frame;
+  m.evict_transients();
+  m.written.fill(false);
+  m.rain->take_drawn();
+  for (Pass* pass : m.views[static_cast<int>(spec.view)]) {
+    m.timed(pass->decl().name, [&] { m.run_pass(*pass, frame, s, resources); });
+  }
+  const RainPass::Drawn rain = m.rain->take_drawn();
+  m.rain_streaks = rain.streaks;
+  // The rain pass's CPU layer, beside the whole pass, for the budget table.
+  if (m.profiling && rain.streaks > 0) m.timings.push_back({"rain_layer", rain.layer_ms});
+  // A GL error here (out of memory for a large target, a lost context) fails this view's frame,
+  // and with it only its session (the scheduler's boundary).
+  if (const GLenum error = glGetError(); error != GL_NO_ERROR) {
+    char text[64];
+    std::snprintf(text, sizeof text, "GL error 0x%04x rendering the %s view", error,
+                  std::string(sim::view_name(spec.view)).c_str());
+    for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) {
+    }  // bounded: a lost context may report itself on every call
+    throw std::runtime_error(text);
+  }
 
-  PendingReadback pending{key, slot, nullptr, spec.width, spec.height};
+  PendingReadback pending{&session, view_index, slot, nullptr, spec.width, spec.height};
   m.timed("readback_start", [&] {
     glNamedFramebufferReadBuffer(target->fbo.id(), GL_COLOR_ATTACHMENT0);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, target->fbo.id());
     glBindBuffer(GL_PIXEL_PACK_BUFFER, target->pbo[slot].id());
     glReadPixels(0, 0, spec.width, spec.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
     glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     glFlush();
-    m.in_flight[{key, slot}] = fence;
+    target->fence[slot] = fence;
     pending.fence = fence;
   });
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -267,15 +474,30 @@ bool Renderer::is_ready(const PendingReadback& pending) const {
 }
 
 void Renderer::finish(const PendingReadback& pending, std::vector<std::uint8_t>& out) {
-  Impl& m = *impl_;
-  const auto it = m.in_flight.find({pending.target_key, pending.slot});
-  if (it == m.in_flight.end()) throw std::logic_error("finish() of a readback not in flight");
-  while (glClientWaitSync(it->second, GL_SYNC_FLUSH_COMMANDS_BIT, 1'000'000'000) ==
-         GL_TIMEOUT_EXPIRED) {
+  if (!pending.session) throw std::logic_error("finish() of an empty readback");
+  RenderSession::Impl& s = *pending.session->impl_;
+  if (static_cast<std::size_t>(pending.view_index) >= s.views.size() ||
+      !s.views[pending.view_index]) {
+    throw std::logic_error("finish() of a readback whose target is gone");
   }
-  glDeleteSync(it->second);
-  m.in_flight.erase(it);
-  const ViewTarget& target = *m.targets.at(pending.target_key);
+  ViewTarget& target = *s.views[pending.view_index];
+  GLsync& fence = target.fence[pending.slot];
+  if (!fence || fence != pending.fence)
+    throw std::logic_error("finish() of a readback not in flight");
+  // A GPU that does not finish a frame in kFenceDeadline is hung or lost: the readback fails (its
+  // session with it), rather than the render thread waiting forever.
+  GLenum waited = GL_TIMEOUT_EXPIRED;
+  const auto deadline = std::chrono::steady_clock::now() + kFenceDeadline;
+  while (waited == GL_TIMEOUT_EXPIRED && std::chrono::steady_clock::now() < deadline)
+    waited = glClientWaitSync(fence, GL_SYNC_FLUSH_COMMANDS_BIT, 100'000'000);
+  glDeleteSync(fence);
+  fence = nullptr;
+  if (waited == GL_TIMEOUT_EXPIRED || waited == GL_WAIT_FAILED) {
+    throw std::runtime_error(waited == GL_WAIT_FAILED
+                                 ? "waiting for the GPU failed"
+                                 : "the GPU did not finish a frame within " +
+                                       std::to_string(kFenceDeadline.count()) + " s");
+  }
   const std::size_t bytes = static_cast<std::size_t>(pending.width) * pending.height * 4;
   out.resize(bytes);
   const GLuint pbo = target.pbo[pending.slot].id();
@@ -285,18 +507,12 @@ void Renderer::finish(const PendingReadback& pending, std::vector<std::uint8_t>&
   glUnmapNamedBuffer(pbo);
 }
 
-void Renderer::release_targets(const std::function<bool(std::uint64_t)>& matches) {
-  for (auto it = impl_->targets.begin(); it != impl_->targets.end();) {
-    it = matches(it->first) ? impl_->targets.erase(it) : std::next(it);
-  }
-}
-
-std::vector<std::uint8_t> render_image(Renderer& renderer, const sim::ViewSpec& spec,
-                                       const sim::SceneState& scene) {
-  constexpr std::uint64_t kImageTarget = ~std::uint64_t{0};
-  const PendingReadback pending = renderer.render(kImageTarget, spec, scene);
+std::vector<std::uint8_t> Renderer::render_image(const sim::ViewSpec& spec,
+                                                 const sim::SceneState& scene) {
+  if (!impl_->image_session) impl_->image_session = open_session();
+  const PendingReadback pending = render(*impl_->image_session, 0, spec, scene);
   std::vector<std::uint8_t> bottom_up;
-  renderer.finish(pending, bottom_up);
+  finish(pending, bottom_up);
   std::vector<std::uint8_t> top_down(bottom_up.size());
   const std::size_t row = static_cast<std::size_t>(spec.width) * 4;
   for (int y = 0; y < spec.height; ++y) {

@@ -1,6 +1,6 @@
 // The renderer: owns the headless GL context and every GL resource, renders the views of a
-// session's scene snapshot and reads their pixels back asynchronously (pixel-pack buffers and
-// fences). Plain C++ interface, no GL types: the session layer drives it from the render thread.
+// session's scene and reads their pixels back asynchronously (pixel-pack buffers and fences).
+// Plain C++ interface, no GL types: the session layer drives it from the render thread.
 #pragma once
 
 #include <cstdint>
@@ -24,14 +24,37 @@ struct PassTiming {
   double ms = 0.0;
 };
 
+// What the renderer keeps for one session between frames: its views' render targets and readback
+// buffers, and its glass water map on the GPU (uploaded once per simulation frame, shared by the
+// views). Made by Renderer::open_session; destroyed on the render thread, after its readbacks
+// have finished.
+class RenderSession {
+ public:
+  ~RenderSession();
+  RenderSession(const RenderSession&) = delete;
+  RenderSession& operator=(const RenderSession&) = delete;
+
+ private:
+  friend class Renderer;
+  struct Impl;
+  explicit RenderSession(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
 // One view's pixels on their way back from the GPU.
 struct PendingReadback {
-  std::uint64_t target_key = 0;
+  RenderSession* session = nullptr;
+  int view_index = 0;
   int slot = 0;
   void* fence = nullptr;
   int width = 0;
   int height = 0;
 };
+
+// The simulation's state after the frame's step (the water on the glass, the rain): called once a
+// pass needs it (on the render thread); it may wait for the step, which runs beside the scene's
+// passes.
+using StepSource = std::function<const sim::SceneState&()>;
 
 class Renderer {
  public:
@@ -48,16 +71,29 @@ class Renderer {
   // with a renderer of its own and take the times as a ranking of the passes.
   void set_profiling(bool on);
   const std::vector<PassTiming>& last_pass_timings() const;
+  // Rain streaks drawn by the last render() (0 if it drew no rain).
+  std::uint32_t last_rain_streaks() const;
 
-  // Renders a view into the render target named target_key (made on first use, remade when the
-  // size changes) and starts its readback.
-  PendingReadback render(std::uint64_t target_key, const sim::ViewSpec& spec,
+  std::unique_ptr<RenderSession> open_session();
+
+  // Renders a session's view `view_index` (its target made on first use, remade when the size
+  // changes) and starts its readback. `scene` holds the frame's inputs (its windshield and rain
+  // are not read); `stepped` gives the state after the step when a pass needs it.
+  PendingReadback render(RenderSession& session, int view_index, const sim::ViewSpec& spec,
+                         const sim::SceneState& scene, const StepSource& stepped);
+  // The same with the scene's own windshield and rain.
+  PendingReadback render(RenderSession& session, int view_index, const sim::ViewSpec& spec,
                          const sim::SceneState& scene);
   bool is_ready(const PendingReadback& pending) const;
   // Waits if needed; out gets RGBA8 rows bottom-up.
   void finish(const PendingReadback& pending, std::vector<std::uint8_t>& out);
-  // Frees the targets whose key matches; pending readbacks of them must be finished first.
-  void release_targets(const std::function<bool(std::uint64_t)>& matches);
+
+  // Renders one view and waits for its pixels, rows top-down (tests, tools).
+  std::vector<std::uint8_t> render_image(const sim::ViewSpec& spec, const sim::SceneState& scene);
+
+  // Frees the shared intermediate targets (remade on demand): after sessions close, so that the
+  // memory of their sizes goes back. Between frames only.
+  void release_shared_targets();
 
  private:
   struct Impl;
@@ -65,8 +101,10 @@ class Renderer {
   std::unique_ptr<Impl> impl_;
 };
 
-// Renders one view and waits for its pixels, rows top-down (tests, tools).
-std::vector<std::uint8_t> render_image(Renderer& renderer, const sim::ViewSpec& spec,
-                                       const sim::SceneState& scene);
+// Renderer::render_image, for callers that hold a renderer by reference.
+inline std::vector<std::uint8_t> render_image(Renderer& renderer, const sim::ViewSpec& spec,
+                                              const sim::SceneState& scene) {
+  return renderer.render_image(spec, scene);
+}
 
 }  // namespace downpour::render

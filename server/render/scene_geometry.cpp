@@ -13,7 +13,11 @@ constexpr double kVerge = 4.0;         // metres of verge beyond the paved edge
 constexpr double kVergeDrop = 0.35;    // how far the verge falls below the pavement edge
 constexpr double kTerrainCell = 20.0;  // metres
 constexpr double kTerrainMargin = 1300.0;
-constexpr int kTerrainChunks = 8;  // per axis
+constexpr int kTerrainChunks = 16;  // per axis
+constexpr int kTerrainLevels = 4;   // cells of 20, 40, 80 and 160 m
+constexpr double kSkirtDepthPerCell = 0.25;
+constexpr double kRoadChunkM = 120.0;
+constexpr double kRoadStepsM[] = {2.0, 8.0, 24.0};  // cross-sections, near to far
 
 double hills(double x, double y) {
   return 5.0 * std::sin(x / 170.0 + 1.3) * std::cos(y / 210.0 - 0.4) +
@@ -22,7 +26,10 @@ double hills(double x, double y) {
 
 }  // namespace
 
-std::vector<MeshData> build_road_chunks(const sim::Track& track, double chunk_length_m) {
+namespace {
+
+// The road in chunks of chunk_length_m with cross-sections every step_m.
+std::vector<MeshData> road_chunks(const sim::Track& track, double chunk_length_m, double step) {
   const double half = track.paved_half_width();
   // Lateral stations of the cross-section, left positive.
   const std::vector<double> stations = {
@@ -34,7 +41,6 @@ std::vector<MeshData> build_road_chunks(const sim::Track& track, double chunk_le
       half,
       half + kVerge};
   std::vector<MeshData> chunks;
-  const double step = 2.0;
   const int rows_total = static_cast<int>(std::ceil(track.length() / step));
   const int rows_per_chunk = std::max(1, static_cast<int>(chunk_length_m / step));
   for (int first = 0; first < rows_total; first += rows_per_chunk) {
@@ -72,6 +78,19 @@ std::vector<MeshData> build_road_chunks(const sim::Track& track, double chunk_le
   return chunks;
 }
 
+}  // namespace
+
+std::vector<std::vector<MeshData>> build_road_chunks(const sim::Track& track) {
+  // Every level's chunks start and end at the same cross-sections (steps divide the length).
+  std::vector<std::vector<MeshData>> levels;
+  for (double step : kRoadStepsM) levels.push_back(road_chunks(track, kRoadChunkM, step));
+  std::vector<std::vector<MeshData>> chunks(levels.front().size());
+  for (auto& level : levels) {
+    for (std::size_t c = 0; c < chunks.size(); ++c) chunks[c].push_back(std::move(level[c]));
+  }
+  return chunks;
+}
+
 double terrain_height(const sim::Track& track, double x, double y) {
   const sim::Track::Projection p = track.project({x, y}, 150.0);
   const double half = track.paved_half_width();
@@ -87,7 +106,7 @@ double terrain_height(const sim::Track& track, double x, double y) {
   return glm::mix(std::min(edge, natural), natural, blend);
 }
 
-std::vector<MeshData> build_terrain_chunks(const sim::Track& track) {
+std::vector<std::vector<MeshData>> build_terrain_chunks(const sim::Track& track) {
   // Bounds of the track plus a margin.
   glm::dvec2 lo(1e30), hi(-1e30);
   for (double s = 0.0; s < track.length(); s += 20.0) {
@@ -111,30 +130,65 @@ std::vector<MeshData> build_terrain_chunks(const sim::Track& track) {
     j = std::clamp(j, 0, ny);
     return heights[j * (nx + 1) + i];
   };
-  std::vector<MeshData> chunks;
+  // A chunk's grid columns (or rows) at every step-th of the fine grid's, and always its last.
+  auto samples = [](int first, int last, int step) {
+    std::vector<int> out;
+    for (int k = first; k < last; k += step) out.push_back(k);
+    out.push_back(last);
+    return out;
+  };
+  std::vector<std::vector<MeshData>> chunks;
   for (int cj = 0; cj < kTerrainChunks; ++cj) {
     for (int ci = 0; ci < kTerrainChunks; ++ci) {
       const int i0 = nx * ci / kTerrainChunks, i1 = nx * (ci + 1) / kTerrainChunks;
       const int j0 = ny * cj / kTerrainChunks, j1 = ny * (cj + 1) / kTerrainChunks;
-      MeshData m;
-      for (int j = j0; j <= j1; ++j) {
-        for (int i = i0; i <= i1; ++i) {
+      std::vector<MeshData> levels;
+      for (int level = 0; level < kTerrainLevels; ++level) {
+        const int step = 1 << level;
+        const std::vector<int> is = samples(i0, i1, step), js = samples(j0, j1, step);
+        MeshData m;
+        auto vertex = [&](int i, int j, float drop) {
           const float x = static_cast<float>(lo.x + i * kTerrainCell);
           const float y = static_cast<float>(lo.y + j * kTerrainCell);
           const glm::vec3 n =
               glm::normalize(glm::vec3(h(i - 1, j) - h(i + 1, j), h(i, j - 1) - h(i, j + 1),
                                        2.0f * static_cast<float>(kTerrainCell)));
-          m.add_vertex({x, y, h(i, j)}, n, {x, y});
+          return m.add_vertex({x, y, h(i, j) - drop}, n, {x, y});
+        };
+        for (int j : js) {
+          for (int i : is) vertex(i, j, 0.0f);
         }
-      }
-      const int cols = i1 - i0 + 1;
-      for (int j = 0; j < j1 - j0; ++j) {
-        for (int i = 0; i < i1 - i0; ++i) {
-          const auto a = static_cast<std::uint32_t>(j * cols + i);
-          m.add_quad(a, a + 1, a + 1 + cols, a + cols);
+        const auto cols = static_cast<std::uint32_t>(is.size());
+        for (std::uint32_t r = 0; r + 1 < js.size(); ++r) {
+          for (std::uint32_t c = 0; c + 1 < cols; ++c) {
+            const std::uint32_t a = r * cols + c;
+            m.add_quad(a, a + 1, a + 1 + cols, a + cols);
+          }
         }
+        // Skirts hanging from the edges hide the cracks where a neighbour is drawn finer.
+        const float drop = static_cast<float>(kSkirtDepthPerCell * step * kTerrainCell + 2.0);
+        auto skirt = [&](const std::vector<std::pair<int, int>>& edge) {
+          for (std::size_t k = 0; k + 1 < edge.size(); ++k) {
+            const std::uint32_t a = vertex(edge[k].first, edge[k].second, 0.0f);
+            const std::uint32_t b = vertex(edge[k + 1].first, edge[k + 1].second, 0.0f);
+            const std::uint32_t c = vertex(edge[k + 1].first, edge[k + 1].second, drop);
+            const std::uint32_t d = vertex(edge[k].first, edge[k].second, drop);
+            m.add_quad(a, b, c, d);
+          }
+        };
+        std::vector<std::pair<int, int>> south, north, west, east;
+        for (int i : is) {
+          south.emplace_back(i, j0);
+          north.emplace_back(i, j1);
+        }
+        for (int j : js) {
+          west.emplace_back(i0, j);
+          east.emplace_back(i1, j);
+        }
+        for (const auto* edge : {&south, &north, &west, &east}) skirt(*edge);
+        levels.push_back(std::move(m));
       }
-      chunks.push_back(std::move(m));
+      chunks.push_back(std::move(levels));
     }
   }
   return chunks;

@@ -2,22 +2,35 @@
 
 #include <glm/geometric.hpp>
 
+#include "server/sim/car_body.hpp"
+
 namespace downpour::render {
 
 MeshData build_car_hull() {
   MeshData m;
   // Lower body from the rear bumper (x = -0.95) to the front bumper (x = 3.65).
-  m.add_frustum({-0.95f, -0.9f, 0.28f}, {3.65f, 0.9f, 0.92f}, {-0.9f, -0.88f}, {3.6f, 0.88f},
-                material::kBody);
+  namespace body = sim::car_body;
+  const auto top = static_cast<float>(body::kHullTopZ);
+  const auto half = static_cast<float>(body::kHullHalfWidth);
+  m.add_frustum({-0.95f, -0.9f, 0.28f}, {3.65f, 0.9f, top},
+                {static_cast<float>(body::kHullRearX), -half},
+                {static_cast<float>(body::kHullFrontX), half}, material::kBody);
   return m;
 }
 
 MeshData build_car_upper() {
   MeshData m;
   // Cabin: glass house narrowing towards the roof.
-  m.add_frustum({-0.55f, -0.82f, 0.92f}, {2.06f, 0.82f, 1.45f}, {-0.2f, -0.7f}, {1.4f, 0.7f},
-                material::kGlass);
-  m.add_box({-0.15f, -0.71f, 1.44f}, {1.35f, 0.71f, 1.47f}, material::kBody);  // roof panel
+  namespace body = sim::car_body;
+  const auto cabin_half = static_cast<float>(body::kCabinHalfWidth);
+  m.add_frustum(
+      {static_cast<float>(body::kCabinRearX), -cabin_half, static_cast<float>(body::kHullTopZ)},
+      {static_cast<float>(body::kCabinFrontX), cabin_half, 1.45f}, {-0.2f, -0.7f}, {1.4f, 0.7f},
+      material::kGlass);
+  const auto roof_half = static_cast<float>(body::kRoofHalfWidth);
+  m.add_box({static_cast<float>(body::kRoofRearX), -roof_half, 1.44f},
+            {static_cast<float>(body::kRoofFrontX), roof_half, static_cast<float>(body::kRoofZ)},
+            material::kBody);  // roof panel
   // Wheels: radius 0.33 at the axles x = 0 and x = 2.7.
   for (float x : {0.0f, 2.7f}) {
     for (float y : {-0.8f, 0.8f}) {
@@ -30,7 +43,16 @@ MeshData build_car_upper() {
   return m;
 }
 
-MeshData build_cockpit_interior(const WindshieldCorners& g) {
+WindshieldCorners windshield_corners(const sim::GlassConfig& glass) {
+  const double inset = glass.inset_mm(glass.height_mm);
+  return {glm::vec3(glass.to_vehicle({glass.bottom_width_mm, 0.0})),
+          glm::vec3(glass.to_vehicle({0.0, 0.0})),
+          glm::vec3(glass.to_vehicle({inset, glass.height_mm})),
+          glm::vec3(glass.to_vehicle({glass.bottom_width_mm - inset, glass.height_mm}))};
+}
+
+MeshData build_cockpit_interior(const sim::GlassConfig& glass) {
+  const WindshieldCorners g = windshield_corners(glass);
   MeshData m;
   const float dash_back = 1.45f;
   // Dashboard top: from the glass's lower edge back towards the driver, slightly lower at the back.

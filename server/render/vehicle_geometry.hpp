@@ -5,18 +5,20 @@
 #include <glm/vec3.hpp>
 
 #include "server/render/mesh_data.hpp"
+#include "server/sim/windshield.hpp"
 
 namespace downpour::render {
 
 inline constexpr glm::dvec3 kDriverEye{1.05, 0.37, 1.22};
 
-// Windshield corners, vehicle frame: a glass raked about 60 degrees from vertical.
+// The windshield's corners in the vehicle frame, from the simulation's glass.
 struct WindshieldCorners {
-  glm::vec3 bottom_right{2.06f, -0.76f, 0.98f};
-  glm::vec3 bottom_left{2.06f, 0.76f, 0.98f};
-  glm::vec3 top_left{1.40f, 0.68f, 1.36f};
-  glm::vec3 top_right{1.40f, -0.68f, 1.36f};
+  glm::vec3 bottom_right;
+  glm::vec3 bottom_left;
+  glm::vec3 top_left;
+  glm::vec3 top_right;
 };
+WindshieldCorners windshield_corners(const sim::GlassConfig& glass);
 
 // Material ids carried in uv.x, read by vehicle.frag and cockpit.frag.
 namespace material {
@@ -32,6 +34,6 @@ inline constexpr float kTrim = 4.0f;
 MeshData build_car_hull();
 MeshData build_car_upper();
 // Dashboard, A-pillars, roof edge and mirror as seen from the driver's seat.
-MeshData build_cockpit_interior(const WindshieldCorners& glass);
+MeshData build_cockpit_interior(const sim::GlassConfig& glass);
 
 }  // namespace downpour::render

@@ -1,4 +1,4 @@
-// The wiper blades as windshield_common.glsl draws them, from the simulation's blade poses.
+// The wiper blades as wiper_blades.glsl draws them, from the simulation's blade poses.
 #pragma once
 
 #include <array>
@@ -8,8 +8,16 @@
 
 namespace downpour::render {
 
-// Sets u_blade_pivot_dir[i] (pivot mm, unit direction) and u_blade_size[i] (length, width mm) of a
-// program that includes windshield_common.glsl. A blade of zero length is not drawn.
-void set_wiper_blade_uniforms(ShaderProgram& program, const std::array<sim::BladePose, 2>& blades);
+// u_blade_pivot_dir[i] (pivot mm, unit direction) and u_blade_size[i] (length, width mm) of a
+// program that includes wiper_blades.glsl, looked up once. A blade of zero length is not drawn.
+class WiperBladeUniforms {
+ public:
+  explicit WiperBladeUniforms(const ShaderProgram& program);
+  void set(const std::array<sim::BladePose, 2>& blades) const;
+
+ private:
+  std::array<Uniform, 2> pivot_dir_;
+  std::array<Uniform, 2> size_;
+};
 
 }  // namespace downpour::render

@@ -33,12 +33,15 @@ void fill_frame(const session::EncodedFrame& f, std::uint64_t reader_drops, v1::
   s->set_drops_on_glass(f.stats.drops_on_glass);
   s->set_glass_wet_fraction(f.stats.glass_wet_fraction);
   s->set_view_wet_fraction(f.stats.view_wet_fraction);
+  s->set_rain_streaks(f.stats.rain_streaks);
+  s->set_visibility_m(f.stats.visibility_m);
   s->set_frames_dropped(reader_drops);
 }
 
 void fill_session_info(const session::Session& session, v1::SessionInfo* out) {
   const session::SessionConfig& c = session.config();
   out->set_session_id(session.id());
+  out->set_owner(c.owner);
   out->set_mode(c.mode == sim::Mode::kLockstep ? v1::MODE_LOCKSTEP : v1::MODE_REALTIME);
   out->set_fps(c.fps);
   out->set_seed(c.seed);
@@ -57,9 +60,17 @@ void fill_session_info(const session::Session& session, v1::SessionInfo* out) {
       spec->mutable_camera_rotation()->set_pitch_deg(v.camera->rotation.pitch_deg);
       spec->mutable_camera_rotation()->set_roll_deg(v.camera->rotation.roll_deg);
     }
+    if (v.focus_distance_m) spec->set_focus_distance_m(*v.focus_distance_m);
+    if (v.aperture_mm) spec->set_aperture_mm(*v.aperture_mm);
+    if (v.exposure_s) spec->set_exposure_s(*v.exposure_s);
   }
   out->set_frames_rendered(session.frames_rendered());
   out->set_sim_time_s(session.sim_time_s());
+  const session::TickStats ticks = session.tick_stats();
+  out->set_frames_late(ticks.frames_late);
+  out->set_achieved_fps(ticks.achieved_fps);
+  out->set_idle_s(session.idle_s(session::Clock::now()));
+  out->set_steps_cancelled(session.steps_cancelled());
 }
 
 }  // namespace downpour::rpc

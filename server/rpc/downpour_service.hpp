@@ -5,16 +5,25 @@
 #include <atomic>
 
 #include "downpour/v1/downpour.grpc.pb.h"
+#include "server/rpc/auth.hpp"
 #include "server/rpc/validation.hpp"
 #include "server/session/frame_scheduler.hpp"
 #include "server/session/session_registry.hpp"
 
 namespace downpour::rpc {
 
-class DownpourService final : public v1::Downpour::CallbackService {
+// Every method on the callback API; Drive raw (bytes), so that it can tell a message that does
+// not parse from the end of the stream.
+using ServiceBase = v1::Downpour::WithCallbackMethod_CreateSession<
+    v1::Downpour::WithCallbackMethod_CloseSession<v1::Downpour::WithCallbackMethod_ListSessions<
+        v1::Downpour::WithCallbackMethod_Update<v1::Downpour::WithCallbackMethod_Step<
+            v1::Downpour::WithRawCallbackMethod_Drive<v1::Downpour::WithCallbackMethod_WatchFrames<
+                v1::Downpour::WithCallbackMethod_GetStats<v1::Downpour::Service>>>>>>>>;
+
+class DownpourService final : public ServiceBase {
  public:
   DownpourService(session::SessionRegistry& registry, session::FrameScheduler& scheduler,
-                  Limits limits);
+                  Limits limits, Authenticator auth = {});
 
   grpc::ServerUnaryReactor* CreateSession(grpc::CallbackServerContext* ctx,
                                           const v1::CreateSessionRequest* request,
@@ -30,7 +39,7 @@ class DownpourService final : public v1::Downpour::CallbackService {
                                    v1::UpdateResponse* response) override;
   grpc::ServerUnaryReactor* Step(grpc::CallbackServerContext* ctx, const v1::StepRequest* request,
                                  v1::StepResponse* response) override;
-  grpc::ServerBidiReactor<v1::DriveRequest, v1::DriveResponse>* Drive(
+  grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer>* Drive(
       grpc::CallbackServerContext* ctx) override;
   grpc::ServerWriteReactor<v1::Frame>* WatchFrames(grpc::CallbackServerContext* ctx,
                                                    const v1::WatchFramesRequest* request) override;
@@ -38,11 +47,23 @@ class DownpourService final : public v1::Downpour::CallbackService {
                                      const v1::GetStatsRequest* request,
                                      v1::ServerStats* response) override;
 
+  // Drain (SIGTERM): new sessions and new steps are refused with UNAVAILABLE from here on; the
+  // steps already accepted are still answered.
+  void begin_drain() { context_.draining = true; }
+  // Steps accepted and not yet answered (Step calls and Drive steps).
+  int steps_in_flight() const { return context_.steps_in_flight.load(); }
+  // Drive and WatchFrames streams not yet done (their final status not yet sent).
+  int open_streams() const { return context_.open_streams.load(); }
+
   // Everything the stream reactors need from the service.
   struct Context {
     session::SessionRegistry& registry;
     Limits limits;
+    Authenticator auth;
     std::atomic<std::uint64_t> reader_drops{0};
+    std::atomic<bool> draining{false};
+    std::atomic<int> steps_in_flight{0};
+    std::atomic<int> open_streams{0};
   };
 
  private:

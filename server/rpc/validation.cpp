@@ -205,6 +205,19 @@ grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, cons
         to_rotation(in.camera_rotation(), field + ".camera_rotation", &pose.rotation));
     out->camera = pose;
   }
+  // The lens applies to every view; those without glass in sight ignore it.
+  if (in.has_focus_distance_m()) {
+    DP_RETURN_IF_ERROR(in_range(in.focus_distance_m(), 0.05, 10000.0, field + ".focus_distance_m"));
+    out->focus_distance_m = in.focus_distance_m();
+  }
+  if (in.has_aperture_mm()) {
+    DP_RETURN_IF_ERROR(in_range(in.aperture_mm(), 0.0, 50.0, field + ".aperture_mm"));
+    out->aperture_mm = in.aperture_mm();
+  }
+  if (in.has_exposure_s()) {
+    DP_RETURN_IF_ERROR(in_range(in.exposure_s(), 0.0, 0.25, field + ".exposure_s"));
+    out->exposure_s = in.exposure_s();
+  }
   return grpc::Status::OK;
 }
 

@@ -17,6 +17,8 @@ struct FrameStats {
   std::uint32_t drops_on_glass = 0;
   double glass_wet_fraction = 0.0;
   double view_wet_fraction = 0.0;
+  std::uint32_t rain_streaks = 0;  // rain streaks drawn in this view
+  double visibility_m = 0.0;       // through the fog and the rain
 };
 
 struct EncodedFrame {
@@ -33,13 +35,26 @@ struct EncodedFrame {
 
 using FramePtr = std::shared_ptr<const EncodedFrame>;
 
+// Why a session ended, so that its streams and its waiting steps end with a status that says so.
+enum class EndReason {
+  kClosed,        // CloseSession
+  kIdle,          // no client was heard for the server's idle timeout
+  kFailed,        // a frame of it failed (the message says how); the others go on
+  kShuttingDown,  // the server is draining
+  kCancelled,     // (a step only) its call was cancelled or ran out of time before it started
+};
+struct SessionEnd {
+  EndReason reason = EndReason::kClosed;
+  std::string message;
+};
+
 // Something that receives a session's frames as they are encoded: a WatchFrames reader, a
 // realtime Drive stream. Called on encoder threads; must not block.
 class FrameSink {
  public:
   virtual ~FrameSink() = default;
   virtual void on_frame(const FramePtr& frame) = 0;
-  virtual void on_session_closed() = 0;
+  virtual void on_session_closed(const SessionEnd& end) = 0;
 };
 
 }  // namespace downpour::session

@@ -1,21 +1,22 @@
 #include "server/session/frame_scheduler.hpp"
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <future>
+#include <thread>
 
 #include <spdlog/spdlog.h>
 
+#include "server/render/atmosphere.hpp"
 #include "server/render/view_wet_fraction.hpp"
 
 namespace downpour::session {
 namespace {
 
 constexpr std::size_t kStatsWindow = 512;
-constexpr double kMaxRealtimeStepS = 0.25;  // a stalled loop does not make the simulation jump
-
-std::uint64_t target_key(std::uint64_t session_number, int view_index) {
-  return session_number * 8 + view_index;
-}
+constexpr auto kIdleWake = std::chrono::milliseconds(100);
+constexpr auto kStatsPeriod = std::chrono::milliseconds(100);  // sessions' tick stats published
 
 double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -48,15 +49,15 @@ struct FrameScheduler::TickCollector {
       }
       if (--remaining > 0 || !done) return;
       outcome.ok = !failed;
-      if (failed) outcome.error = "encoding a frame failed";
+      if (failed) outcome.error = "a frame failed";  // failure: kFailed (the log says how)
       outcome.frames = std::move(frames);
     }
     done(std::move(outcome));
   }
 };
 
+// A view's frame between its render and its encoding.
 struct FrameScheduler::InFlight {
-  render::PendingReadback readback;
   std::shared_ptr<Session> session;
   std::shared_ptr<TickCollector> collector;
   int view_index = 0;
@@ -67,8 +68,9 @@ struct FrameScheduler::InFlight {
   std::uint32_t drops_on_glass = 0;
   double glass_wet_fraction = 0.0;
   double view_wet_fraction = 0.0;
+  std::uint32_t rain_streaks = 0;
+  double visibility_m = 0.0;
   Clock::time_point inputs_arrived;
-  bool from_earlier_loop = false;
 };
 
 FrameScheduler::FrameScheduler(SessionRegistry& registry, SchedulerOptions options)
@@ -123,7 +125,7 @@ SchedulerStats FrameScheduler::stats() const {
   s.renderer = renderer_name_;
   s.frames_rendered = frames_rendered_;
   s.frames_encoded = frames_encoded_;
-  s.realtime_ticks_skipped = ticks_skipped_;
+  s.realtime_frames_late = frames_late_;
   s.render_ms_median = median(render_ms_window_);
   s.encode_ms_median = median(encode_ms_window_);
   s.encoder_threads = encoders_.threads();
@@ -139,198 +141,362 @@ void FrameScheduler::run(std::promise<void>* started) {
   try {
     renderer_ = render::Renderer::create(options_.renderer);
     renderer_->set_profiling(options_.profile_passes);
-    // Warm-up: a first frame proves the context, shaders and readback before we report ready.
-    sim::ViewSpec warm{sim::View::kCockpit, 64, 36, 85, 0.0, std::nullopt};
-    const std::vector<std::uint8_t> pixels =
-        render::render_image(*renderer_, warm, sim::SceneState{});
-    renderer_->release_targets([](std::uint64_t) { return true; });
-    if (pixels.size() != 64u * 36u * 4u) throw std::runtime_error("warm-up frame came back empty");
+    readbacks_ = std::make_unique<render::ReadbackQueue<InFlight>>(
+        *renderer_, [this](std::size_t bytes) { return encoders_.take_buffer(bytes); });
+    // Warm-up: first frames prove the context, shaders and readback before we report ready, and
+    // have llvmpipe compile every pass's shaders (a drop and the blades on the glass) rather than
+    // a session's first frames.
+    sim::SceneState warm_scene;
+    sim::Simulation warm_sim(0, {});
+    warm_scene.windshield.metaballs.push_back({700.0f, 400.0f, 3.0f});
+    warm_scene.windshield.blades = warm_sim.state().windshield.blades;
+    sim::GlassWaterMapBuilder(warm_scene.glass)
+        .build(warm_scene.windshield.metaballs, warm_scene.windshield.map);
+    for (const sim::View view : {sim::View::kCockpit, sim::View::kRoad, sim::View::kWindshield}) {
+      const std::vector<std::uint8_t> pixels =
+          render::render_image(*renderer_, sim::view_spec(view, 64, 36), warm_scene);
+      if (pixels.size() != 64u * 36u * 4u)
+        throw std::runtime_error("warm-up frame came back empty");
+    }
     {
       std::lock_guard lock(stats_mutex_);
       renderer_name_ = renderer_->gl_renderer() + " (EGL " + renderer_->platform() + ")";
     }
     started->set_value();
   } catch (...) {
+    readbacks_.reset();
     renderer_.reset();
     started->set_exception(std::current_exception());
     return;
   }
 
   while (!stopping_) {
-    const auto live = registry_.list();
     const Clock::time_point now = Clock::now();
-    bool worked = false;
-    Clock::time_point next_wake = now + std::chrono::milliseconds(100);
-    for (const auto& s : live) {
-      if (s->closed()) continue;
-      if (s->config().mode == sim::Mode::kLockstep) {
-        worked |= run_lockstep(s);
-      } else {
-        worked |= run_realtime(s, now);
-        next_wake = std::min(next_wake, s->next_due);
-      }
+    heartbeat_ = now.time_since_epoch().count();
+    try {
+      loop_once(now);
+    } catch (const std::exception& e) {
+      // Not one session's (those are caught nearer): log, and keep the loop and the others going.
+      spdlog::critical("render loop: {}", e.what());
+      std::this_thread::sleep_for(kIdleWake);
     }
-    collect(false);
-    release_closed_sessions(live);
-    if (worked) continue;
-    if (!in_flight_.empty()) {
-      // Nothing new to render: finish what is in flight rather than wait on the GPU's pace.
-      collect(true);
-      continue;
-    }
-    std::unique_lock lock(wake_mutex_);
-    wake_cv_.wait_until(lock, next_wake, [&] { return woken_ || stopping_.load(); });
-    woken_ = false;
   }
+  drop_step_ahead(EndReason::kShuttingDown, "the server is stopping");
   collect(true);
+  readbacks_.reset();
+  render_sessions_.clear();
   renderer_.reset();
 }
 
-bool FrameScheduler::run_lockstep(const std::shared_ptr<Session>& s) {
+double FrameScheduler::stalled_s(Clock::time_point now) const {
+  const Clock::rep beat = heartbeat_.load();
+  if (beat == 0) return 0.0;
+  return std::max(
+      0.0, std::chrono::duration<double>(now - Clock::time_point(Clock::duration(beat))).count());
+}
+
+void FrameScheduler::loop_once(Clock::time_point now) {
+  sync_sessions(now);
+  // A lockstep session is due once a step waits; any session renders only if the encoders have
+  // room for its views (the render thread never waits for them: their completion wakes it).
+  const auto tick = policy_.next(
+      now,
+      [this](std::uint64_t id) -> std::optional<Clock::time_point> {
+        if (ahead_ && ahead_->session->number() == id) return ahead_->job.arrived;
+        return live_.at(id)->oldest_step_arrival();
+      },
+      [this](std::uint64_t id) {
+        return encoders_.try_reserve(static_cast<int>(live_.at(id)->config().views.size()));
+      });
+  if (tick) {
+    const std::shared_ptr<Session> s = live_.at(tick->session);
+    const Clock::time_point started = Clock::now();
+    try {
+      run_tick(*tick);
+      // Its share of the loop is counted in the render thread's time its tick took.
+      policy_.charge(tick->session, std::chrono::duration<double>(Clock::now() - started).count());
+    } catch (const std::exception& e) {
+      // One session's failed frame (a render target it asked for, its step) ends that session,
+      // not the server.
+      spdlog::error("session {}: a frame failed ({}); closing the session", s->id(), e.what());
+      registry_.close(s->id(), {EndReason::kFailed,
+                                "session " + s->id() + " failed and was closed: " + e.what()});
+    }
+    collect(false);
+    return;
+  }
+  collect(false);
+  if (!readbacks_->empty()) {
+    // Nothing new to render: finish what is in flight rather than wait on the GPU's pace.
+    collect(true);
+    return;
+  }
+  std::unique_lock lock(wake_mutex_);
+  wake_cv_.wait_until(lock, policy_.next_wake(now, kIdleWake),
+                      [&] { return woken_ || stopping_.load(); });
+  woken_ = false;
+}
+
+void FrameScheduler::drop_step_ahead(EndReason reason, const std::string& why) {
+  if (!ahead_) return;
+  step_worker_.wait();
+  if (ahead_->job.done) ahead_->job.done({false, why, reason, {}});
+  ahead_.reset();
+}
+
+void FrameScheduler::sync_sessions(Clock::time_point now) {
+  for (const auto& s : registry_.close_idle(now)) {
+    spdlog::info("session {} closed: no client heard for {:g} s (--session-idle-timeout-s)",
+                 s->id(), registry_.idle_timeout_s());
+  }
+  std::map<std::uint64_t, std::shared_ptr<Session>> live;
+  for (auto& s : registry_.list()) {
+    if (s->closed()) continue;
+    const std::uint64_t id = s->number();
+    if (!policy_.contains(id)) policy_.add(id, s->config().mode, s->config().fps, now);
+    s->drop_cancelled();
+    live.emplace(id, std::move(s));
+  }
+  for (const auto& [id, s] : live_) {
+    if (live.count(id)) continue;
+    frames_late_closed_ += policy_.stats(id, now).frames_late;  // the server's total keeps them
+    policy_.remove(id);
+  }
+  live_ = std::move(live);
+  if (ahead_ && !live_.count(ahead_->session->number()))
+    drop_step_ahead(EndReason::kClosed, "session " + ahead_->session->id() + " was closed");
+  // A closed session's render targets go once no readback of them is in flight; then the shared
+  // targets and buffers sized for it, and the heap's free pages go back to the system.
+  bool released = false;
+  for (auto it = render_sessions_.begin(); it != render_sessions_.end();) {
+    const bool gone = !live_.count(it->first) && !readbacks_->holds(it->second.get());
+    released |= gone;
+    it = gone ? render_sessions_.erase(it) : std::next(it);
+  }
+  if (released) {
+    renderer_->release_shared_targets();
+    encoders_.release_spare_buffers();
+    malloc_trim(0);
+  }
+  if (now - stats_published_ >= kStatsPeriod) {
+    stats_published_ = now;
+    std::uint64_t late = frames_late_closed_;
+    for (const auto& [id, s] : live_) {
+      const TickStats t = policy_.stats(id, now);
+      s->set_tick_stats(t);
+      late += t.frames_late;
+    }
+    frames_late_ = late;
+  }
+}
+
+void FrameScheduler::run_tick(const TickPolicy::Tick& t) {
+  const std::shared_ptr<Session>& s = live_.at(t.session);
   const int views = static_cast<int>(s->config().views.size());
-  if (!encoders_.try_reserve(views)) return false;  // the encoder's completion wakes us
-  while (auto job = s->pop_job()) {
-    s->simulation().apply(job->update);
-    if (job->dt_s <= 0.0) continue;  // update only
-    tick(s, job->dt_s, std::move(job->done), job->arrived);
-    return true;
+  // The encoders' room for this tick's views: tick() gives back what it does not render.
+  bool ticked = false;
+  try {
+    if (s->config().mode == sim::Mode::kRealtime) {
+      Clock::time_point arrived = Clock::now();
+      if (auto update = s->take_update()) {
+        s->simulation().apply(update->first);
+        arrived = update->second;
+      }
+      const StartedStep step = start_step(*s, t.dt_s);
+      ticked = true;
+      tick(s, step, nullptr, arrived);
+      return;
+    }
+    if (ahead_ && ahead_->session == s) {  // its step has been running since its last tick
+      StepAhead ahead = std::move(*ahead_);
+      ahead_.reset();
+      ticked = true;
+      tick(s, ahead.step, std::move(ahead.job.done), ahead.job.arrived);
+    } else if (auto job = pop_step(*s)) {
+      StepDone done = std::move(job->done);
+      StartedStep step;
+      try {
+        step = start_step(*s, job->dt_s);
+      } catch (...) {
+        if (done) done({false, "the step could not start", EndReason::kFailed, {}});
+        throw;
+      }
+      ticked = true;
+      tick(s, step, std::move(done), job->arrived);
+    } else {
+      encoders_.release_reservation(views);  // the session was closed meanwhile
+      return;
+    }
+  } catch (...) {
+    if (!ticked) encoders_.release_reservation(views);
+    throw;
   }
-  encoders_.release_reservation(views);
-  return false;
+  // The session's next step, if it is already queued, runs while this one's frames are read
+  // back and encoded and while other sessions render.
+  if (!ahead_) {
+    if (auto job = pop_step(*s)) {
+      ahead_ = StepAhead{s, std::move(*job), {}};
+      ahead_->step = start_step(*s, ahead_->job.dt_s);
+    }
+  }
 }
 
-bool FrameScheduler::run_realtime(const std::shared_ptr<Session>& s, Clock::time_point now) {
-  const auto period = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(1.0 / s->config().fps));
-  if (s->last_tick == Clock::time_point{}) {
-    s->last_tick = now - period;
-    s->next_due = now;
+std::optional<StepJob> FrameScheduler::pop_step(Session& s) {
+  // The updates queued before the step apply first, in order; updates alone wait for a step.
+  if (!s.oldest_step_arrival()) return std::nullopt;
+  while (auto job = s.pop_job()) {
+    step_worker_.wait();  // a step started ahead may still be running on this simulation
+    s.simulation().apply(job->update);
+    if (job->dt_s > 0.0) return job;
   }
-  if (now < s->next_due) return false;
-  s->next_due += period;
-  if (s->next_due < now)
-    s->next_due = now + period;  // fell behind: do not try to catch up in a burst
-  if (!encoders_.try_reserve(static_cast<int>(s->config().views.size()))) {
-    ++ticks_skipped_;
-    return false;
-  }
-  Clock::time_point arrived = now;
-  if (auto update = s->take_update()) {
-    s->simulation().apply(update->first);
-    arrived = update->second;
-  }
-  const double dt =
-      std::min(std::chrono::duration<double>(now - s->last_tick).count(), kMaxRealtimeStepS);
-  s->last_tick = now;
-  tick(s, dt, nullptr, arrived);
-  return true;
+  return std::nullopt;
 }
 
-void FrameScheduler::tick(const std::shared_ptr<Session>& s, double dt_s, StepDone done,
+FrameScheduler::StartedStep FrameScheduler::start_step(Session& s, double dt_s) {
+  step_worker_.wait();  // one step at a time: another session's, started ahead, finishes first
+  sim::Simulation& simulation = s.simulation();
+  StartedStep step;
+  step.inputs = simulation.inputs_after(dt_s);
+  step.failure = std::make_shared<std::exception_ptr>();
+  // What the step throws is kept for the tick that waits for it (and rethrown there).
+  step_worker_.start([&simulation, dt_s, failure = step.failure] {
+    try {
+      simulation.advance(dt_s);
+    } catch (...) {
+      *failure = std::current_exception();
+    }
+  });
+  return step;
+}
+
+void FrameScheduler::tick(const std::shared_ptr<Session>& s, const StartedStep& step, StepDone done,
                           Clock::time_point inputs_arrived) {
-  s->simulation().advance(dt_s);
-  s->note_sim_time();
-  const sim::SceneState& scene = s->simulation().state();
+  // The water steps on its own thread while the scene's passes, which need only the frame's
+  // inputs, are drawn; a pass that needs the water waits for it.
+  const sim::SceneState& inputs = step.inputs;
+  sim::Simulation& simulation = s->simulation();
+  bool stepped = false;
+  const render::StepSource water = [&]() -> const sim::SceneState& {
+    if (!stepped) {
+      step_worker_.wait();
+      stepped = true;
+      if (step.failure && *step.failure) std::rethrow_exception(*step.failure);
+    }
+    return simulation.state();
+  };
   const std::uint64_t frame_number = s->begin_frame();
   const auto& views = s->config().views;
   auto collector = std::make_shared<TickCollector>();
   collector->frames.resize(views.size());
   collector->remaining = static_cast<int>(views.size());
   collector->done = std::move(done);
-  for (std::size_t i = 0; i < views.size(); ++i) {
-    const Clock::time_point t0 = Clock::now();
-    InFlight f;
-    f.readback = renderer_->render(target_key(s->number(), static_cast<int>(i)), views[i], scene);
-    f.render_ms = ms_since(t0);
-    f.session = s;
-    f.collector = collector;
-    f.view_index = static_cast<int>(i);
-    f.frame_number = frame_number;
-    f.sim_time_s = scene.sim_time_s;
-    f.client_time_s = scene.client_time_s;
+  std::vector<std::pair<render::PendingReadback, InFlight>> rendered;
+  try {
+    std::unique_ptr<render::RenderSession>& targets = render_sessions_[s->number()];
+    if (!targets) targets = renderer_->open_session();
+    // The same air for every view of the tick.
+    const double visibility_m = render::visibility_m(render::atmosphere_from(inputs.weather));
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      const Clock::time_point t0 = Clock::now();
+      InFlight f;
+      const render::PendingReadback readback =
+          renderer_->render(*targets, static_cast<int>(i), views[i], inputs, water);
+      f.render_ms = ms_since(t0);
+      f.rain_streaks = renderer_->last_rain_streaks();
+      f.visibility_m = visibility_m;
+      f.session = s;
+      f.collector = collector;
+      f.view_index = static_cast<int>(i);
+      f.frame_number = frame_number;
+      f.sim_time_s = inputs.sim_time_s;
+      f.client_time_s = inputs.client_time_s;
+      f.inputs_arrived = inputs_arrived;
+      ++frames_rendered_;
+      std::lock_guard lock(stats_mutex_);
+      record(render_ms_window_, render_ms_next_, f.render_ms);
+      if (options_.profile_passes) pass_timings_ = renderer_->last_pass_timings();
+      rendered.emplace_back(readback, std::move(f));
+    }
+    water();  // views that drew no water still wait for the step: the next tick builds on it
+  } catch (...) {
+    // The step must not outlive this call; the views rendered go on to the encoders (their
+    // readbacks are in flight), the others fail the step and give back their encoder room.
+    step_worker_.wait();
+    for (auto& [readback, f] : rendered) readbacks_->push(readback, std::move(f));
+    const int missing = static_cast<int>(views.size() - rendered.size());
+    encoders_.release_reservation(missing);
+    for (std::size_t i = rendered.size(); i < views.size(); ++i)
+      collector->add(static_cast<int>(i), nullptr);
+    throw;
+  }
+  s->note_sim_time();
+  const sim::SceneState& scene = simulation.state();
+  for (auto& [readback, f] : rendered) {
     f.drops_on_glass = scene.windshield.drops + scene.windshield.particles;
     f.glass_wet_fraction = scene.windshield.glass_wet_fraction;
-    f.view_wet_fraction = render::view_wet_fraction(views[i], scene);
-    f.inputs_arrived = inputs_arrived;
-    in_flight_.push_back(std::move(f));
-    ++frames_rendered_;
-    std::lock_guard lock(stats_mutex_);
-    record(render_ms_window_, render_ms_next_, in_flight_.back().render_ms);
-    if (options_.profile_passes) pass_timings_ = renderer_->last_pass_timings();
+    f.view_wet_fraction = render::view_wet_fraction(views[f.view_index], scene);
+    readbacks_->push(readback, std::move(f));
   }
 }
 
-void FrameScheduler::collect(bool force_all) {
-  std::vector<InFlight> waiting;
-  for (InFlight& f : in_flight_) {
-    // A readback from an earlier loop is finished now (waiting if needed): each target has only
-    // two readback slots.
-    if (!force_all && !f.from_earlier_loop && !renderer_->is_ready(f.readback)) {
-      f.from_earlier_loop = true;
-      waiting.push_back(std::move(f));
-      continue;
-    }
-    const Clock::time_point t0 = Clock::now();
-    const std::size_t bytes = static_cast<std::size_t>(f.readback.width) * f.readback.height * 4;
-    std::vector<std::uint8_t> pixels = encoders_.take_buffer(bytes);
-    renderer_->finish(f.readback, pixels);
-    const double readback_ms = ms_since(t0);
-    const sim::ViewSpec& spec = f.session->config().views[f.view_index];
-    encode::EncodeJob job;
-    job.rgba = std::move(pixels);
-    job.width = spec.width;
-    job.height = spec.height;
-    job.quality = spec.jpeg_quality;
-    job.done = [this, f = std::move(f), readback_ms, spec](std::string jpeg, double encode_ms) {
-      if (jpeg.empty()) {
-        spdlog::error("session {}: encoding frame {} failed", f.session->id(), f.frame_number);
+void FrameScheduler::collect(bool all) {
+  readbacks_->collect(
+      all,
+      [this](InFlight f, std::vector<std::uint8_t> pixels, double wait_ms) {
+        encode(std::move(f), std::move(pixels), wait_ms);
+      },
+      [this](InFlight f, const std::string& what) {
+        // The frame is lost: its step fails and its session ends; the other sessions go on.
+        spdlog::error("session {}: reading frame {} back failed ({}); closing the session",
+                      f.session->id(), f.frame_number, what);
         f.collector->add(f.view_index, nullptr);
-        return;
-      }
-      auto frame = std::make_shared<EncodedFrame>();
-      frame->session_id = f.session->id();
-      frame->frame_number = f.frame_number;
-      frame->sim_time_s = f.sim_time_s;
-      frame->client_time_s = f.client_time_s;
-      frame->view = spec.view;
-      frame->width = spec.width;
-      frame->height = spec.height;
-      frame->jpeg = std::move(jpeg);
-      frame->stats.render_ms = f.render_ms;
-      frame->stats.readback_ms = readback_ms;
-      frame->stats.encode_ms = encode_ms;
-      frame->stats.latency_ms = ms_since(f.inputs_arrived);
-      frame->stats.drops_on_glass = f.drops_on_glass;
-      frame->stats.glass_wet_fraction = f.glass_wet_fraction;
-      frame->stats.view_wet_fraction = f.view_wet_fraction;
-      ++frames_encoded_;
-      {
-        std::lock_guard lock(stats_mutex_);
-        record(encode_ms_window_, encode_ms_next_, encode_ms);
-      }
-      FramePtr shared = std::move(frame);
-      f.session->publish(shared);
-      f.collector->add(f.view_index, std::move(shared));
-    };
-    encoders_.submit(std::move(job));
-  }
-  in_flight_ = std::move(waiting);
+        registry_.close(
+            f.session->id(),
+            {EndReason::kFailed, "session " + f.session->id() + " failed and was closed: " + what});
+      });
 }
 
-void FrameScheduler::release_closed_sessions(const std::vector<std::shared_ptr<Session>>& live) {
-  std::vector<std::uint64_t> now_live;
-  for (const auto& s : live) now_live.push_back(s->number());
-  for (std::uint64_t number : known_sessions_) {
-    if (std::find(now_live.begin(), now_live.end(), number) != now_live.end()) continue;
-    const bool busy = std::any_of(in_flight_.begin(), in_flight_.end(),
-                                  [&](const InFlight& f) { return f.session->number() == number; });
-    if (busy) {
-      now_live.push_back(number);  // release once its readbacks are done
-      continue;
+void FrameScheduler::encode(InFlight f, std::vector<std::uint8_t> pixels, double readback_ms) {
+  const sim::ViewSpec& spec = f.session->config().views[f.view_index];
+  encode::EncodeJob job;
+  job.rgba = std::move(pixels);
+  job.width = spec.width;
+  job.height = spec.height;
+  job.quality = spec.jpeg_quality;
+  job.done = [this, f = std::move(f), readback_ms, spec](std::string jpeg, double encode_ms) {
+    if (jpeg.empty()) {
+      spdlog::error("session {}: encoding frame {} failed", f.session->id(), f.frame_number);
+      f.collector->add(f.view_index, nullptr);
+      return;
     }
-    renderer_->release_targets([&](std::uint64_t key) { return key / 8 == number; });
-  }
-  known_sessions_ = std::move(now_live);
+    auto frame = std::make_shared<EncodedFrame>();
+    frame->session_id = f.session->id();
+    frame->frame_number = f.frame_number;
+    frame->sim_time_s = f.sim_time_s;
+    frame->client_time_s = f.client_time_s;
+    frame->view = spec.view;
+    frame->width = spec.width;
+    frame->height = spec.height;
+    frame->jpeg = std::move(jpeg);
+    frame->stats.render_ms = f.render_ms;
+    frame->stats.readback_ms = readback_ms;
+    frame->stats.encode_ms = encode_ms;
+    frame->stats.latency_ms = ms_since(f.inputs_arrived);
+    frame->stats.drops_on_glass = f.drops_on_glass;
+    frame->stats.glass_wet_fraction = f.glass_wet_fraction;
+    frame->stats.view_wet_fraction = f.view_wet_fraction;
+    frame->stats.rain_streaks = f.rain_streaks;
+    frame->stats.visibility_m = f.visibility_m;
+    ++frames_encoded_;
+    {
+      std::lock_guard lock(stats_mutex_);
+      record(encode_ms_window_, encode_ms_next_, encode_ms);
+    }
+    FramePtr shared = std::move(frame);
+    f.session->publish(shared);
+    f.collector->add(f.view_index, std::move(shared));
+  };
+  encoders_.submit(std::move(job));
 }
 
 }  // namespace downpour::session

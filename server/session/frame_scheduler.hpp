@@ -1,23 +1,31 @@
-// The render loop: one thread that owns the GL context. It picks the sessions that are due
-// (realtime by their frame rate, lockstep by a pending step), applies their inputs, steps their
-// simulations, renders each view, starts the readbacks and hands finished pixels to the encoder
-// workers, which publish the frames. Rendering frame N+1 overlaps encoding frame N.
+// The render loop: one thread that owns the GL context. Which session ticks next is TickPolicy's
+// call (earliest deadline first); the loop applies the session's inputs, starts its simulation
+// step on the step thread, renders each view (the water's passes wait for the step), queues the
+// readbacks and hands finished pixels to the encoder workers, which publish the frames. Rendering
+// frame N+1 overlaps encoding frame N; a lockstep session's next step, when already queued, runs
+// while frame N is read back; the render thread never waits for an encoder.
 #pragma once
 
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <future>
+#include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "server/encode/encoder_pool.hpp"
+#include "server/render/readback_queue.hpp"
 #include "server/render/renderer.hpp"
 #include "server/session/session_registry.hpp"
+#include "server/session/tick_policy.hpp"
+#include "server/sim/worker_thread.hpp"
 
 namespace downpour::session {
 
@@ -31,7 +39,7 @@ struct SchedulerStats {
   std::string renderer;
   std::uint64_t frames_rendered = 0;
   std::uint64_t frames_encoded = 0;
-  std::uint64_t realtime_ticks_skipped = 0;  // encoders busy when a realtime tick was due
+  std::uint64_t realtime_frames_late = 0;  // every session's frame slots missed, together
   double render_ms_median = 0.0;
   double encode_ms_median = 0.0;
   int encoder_threads = 0;
@@ -49,6 +57,8 @@ class FrameScheduler {
   void wake();
 
   SchedulerStats stats() const;
+  // Seconds since the render loop last came round (0 before it starts): a watchdog's input.
+  double stalled_s(Clock::time_point now) const;
   // Pass timings of the last rendered view (with profile_passes on).
   std::vector<render::PassTiming> last_pass_timings() const;
 
@@ -57,25 +67,56 @@ class FrameScheduler {
   struct TickCollector;
 
   void run(std::promise<void>* started);
-  bool run_lockstep(const std::shared_ptr<Session>& s);
-  bool run_realtime(const std::shared_ptr<Session>& s, Clock::time_point now);
-  void tick(const std::shared_ptr<Session>& s, double dt_s, StepDone done,
+  // Brings the policy and the renderer's per-session resources in line with the registry.
+  void sync_sessions(Clock::time_point now);
+  // A step running on the step thread: the frame's inputs (the state after the step but for the
+  // water), and what the step threw, if it did.
+  struct StartedStep {
+    sim::SceneState inputs;
+    std::shared_ptr<std::exception_ptr> failure;
+  };
+
+  // Throws when the session's frame fails (it is then closed); its step is failed, its encoder
+  // room given back.
+  void run_tick(const TickPolicy::Tick& tick);
+  // A lockstep session's next step job, the updates queued before it applied; none if no step
+  // waits.
+  std::optional<StepJob> pop_step(Session& s);
+  StartedStep start_step(Session& s, double dt_s);
+  void tick(const std::shared_ptr<Session>& s, const StartedStep& step, StepDone done,
             Clock::time_point inputs_arrived);
-  void collect(bool force_all);
-  void release_closed_sessions(const std::vector<std::shared_ptr<Session>>& live);
+  // Fails the step started ahead (its session closed, the server stopping).
+  void drop_step_ahead(EndReason reason, const std::string& why);
+  void collect(bool all);
+  void loop_once(Clock::time_point now);  // one turn of the render loop
+  void encode(InFlight f, std::vector<std::uint8_t> pixels, double readback_ms);
   void record(std::vector<double>& window, std::size_t& next, double value);
 
   SessionRegistry& registry_;
   const SchedulerOptions options_;
-  std::unique_ptr<render::Renderer> renderer_;  // render thread only
-  std::vector<InFlight> in_flight_;             // render thread only
-  std::vector<std::uint64_t> known_sessions_;   // render thread only
+  // Render thread only:
+  std::unique_ptr<render::Renderer> renderer_;
+  std::unique_ptr<render::ReadbackQueue<InFlight>> readbacks_;
+  std::map<std::uint64_t, std::shared_ptr<Session>> live_;  // by number
+  std::map<std::uint64_t, std::unique_ptr<render::RenderSession>> render_sessions_;
+  TickPolicy policy_;
+  // A lockstep session's next step, started as soon as its last tick was drawn when it was
+  // already queued: it runs while that tick's frames are read back and encoded.
+  struct StepAhead {
+    std::shared_ptr<Session> session;
+    StepJob job;
+    StartedStep step;
+  };
+  std::optional<StepAhead> ahead_;
+  Clock::time_point stats_published_;
+  sim::WorkerThread step_worker_;
   std::thread thread_;
 
   std::mutex wake_mutex_;
   std::condition_variable wake_cv_;
   bool woken_ = false;  // guarded by wake_mutex_
   std::atomic<bool> stopping_{false};
+  std::atomic<Clock::rep> heartbeat_{0};  // when the render loop last came round
 
   mutable std::mutex stats_mutex_;
   std::string renderer_name_;                     // guarded by stats_mutex_
@@ -86,7 +127,8 @@ class FrameScheduler {
   std::vector<render::PassTiming> pass_timings_;  // guarded by stats_mutex_
   std::atomic<std::uint64_t> frames_rendered_{0};
   std::atomic<std::uint64_t> frames_encoded_{0};
-  std::atomic<std::uint64_t> ticks_skipped_{0};
+  std::atomic<std::uint64_t> frames_late_{0};
+  std::uint64_t frames_late_closed_ = 0;  // render thread only
   // Last, so that it is destroyed first: its workers finish their jobs, which use the members
   // above.
   encode::EncoderPool encoders_;

@@ -398,8 +398,7 @@ Scenario highway_heavy_rain() {
   s.loop = true;
   s.seed = 7;
   s.fps = 30.0;
-  s.views = {{View::kCockpit, 640, 360, 85, 0.0, std::nullopt},
-             {View::kRoad, 640, 360, 85, 0.0, std::nullopt}};
+  s.views = {view_spec(View::kCockpit, 640, 360), view_spec(View::kRoad, 640, 360)};
   s.keyframes = drive_lap(track, 1, 25.0, 0.5);
   s.duration_s = s.keyframes.back().t;
   Weather w;
@@ -423,8 +422,7 @@ Scenario city_drizzle() {
   s.loop = true;
   s.seed = 11;
   s.fps = 30.0;
-  s.views = {{View::kCockpit, 640, 360, 85, 0.0, std::nullopt},
-             {View::kRoad, 640, 360, 85, 0.0, std::nullopt}};
+  s.views = {view_spec(View::kCockpit, 640, 360), view_spec(View::kRoad, 640, 360)};
   s.keyframes = drive_lap(track, 0, 8.0, 1.0);
   s.duration_s = s.keyframes.back().t;
   Weather w;

@@ -1,5 +1,6 @@
 #include "server/sim/simulation.hpp"
 
+#include <chrono>
 #include <cmath>
 
 #include <glm/mat3x3.hpp>
@@ -13,10 +14,22 @@ Simulation::Simulation(std::uint64_t seed, const Update& initial, SimulationConf
       seed_(seed),
       wipers_(config.windshield.wipers),
       water_(config.windshield, seed),
+      rain_(seed, config.rain),
+      water_map_(config.windshield.glass, config.water_map),
       blades_at_water_step_(wipers_.poses()) {
   state_.glass = config_.windshield.glass;
   apply(initial);
+  publish();
+}
+
+void Simulation::publish() {
   water_.publish(state_.windshield);
+  water_map_.build(state_.windshield.metaballs, state_.windshield.map);
+  const auto t0 = std::chrono::steady_clock::now();
+  rain_.publish(&state_.rain);
+  rain_ms_ +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  state_.windshield.glass_wet_fraction = state_.windshield.map.wet_fraction;
 }
 
 void Simulation::apply(const Update& update) {
@@ -28,13 +41,41 @@ void Simulation::apply(const Update& update) {
 }
 
 void Simulation::advance(double dt_s) {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  rain_ms_ = 0.0;
   carry_s_ += dt_s;
-  // A small tolerance keeps dt = k * sub_step from losing a step to rounding.
-  while (carry_s_ >= config_.sub_step_s * (1.0 - 1e-9)) {
+  while (whole_sub_step_due(carry_s_)) {
     sub_step();
     carry_s_ -= config_.sub_step_s;
   }
-  water_.publish(state_.windshield);
+  const auto t1 = Clock::now();
+  const double rain_step_ms = rain_ms_;
+  publish();
+  timing_.rain_ms = rain_ms_;
+  timing_.water_ms = std::chrono::duration<double, std::milli>(t1 - t0).count() - rain_step_ms;
+  timing_.publish_ms = std::chrono::duration<double, std::milli>(Clock::now() - t1).count() -
+                       (rain_ms_ - rain_step_ms);
+}
+
+bool Simulation::whole_sub_step_due(double carry_s) const {
+  // A small tolerance keeps dt = k * sub_step from losing a step to rounding.
+  return carry_s >= config_.sub_step_s * (1.0 - 1e-9);
+}
+
+SceneState Simulation::inputs_after(double dt_s) const {
+  SceneState inputs;
+  inputs.client_time_s = state_.client_time_s;
+  inputs.vehicle = state_.vehicle;
+  inputs.wipers = state_.wipers;
+  inputs.weather = state_.weather;
+  inputs.traffic = state_.traffic;
+  inputs.glass = state_.glass;
+  inputs.sub_steps = state_.sub_steps;
+  for (double carry = carry_s_ + dt_s; whole_sub_step_due(carry); carry -= config_.sub_step_s)
+    ++inputs.sub_steps;
+  inputs.sim_time_s = static_cast<double>(inputs.sub_steps) * config_.sub_step_s;
+  return inputs;
 }
 
 glm::dvec3 Simulation::air_velocity_vehicle() const {
@@ -48,6 +89,10 @@ glm::dvec3 Simulation::air_velocity_vehicle() const {
 void Simulation::sub_step() {
   state_.sim_time_s = static_cast<double>(++state_.sub_steps) * config_.sub_step_s;
   wipers_.advance(config_.sub_step_s, state_.wipers);
+  const auto t0 = std::chrono::steady_clock::now();
+  rain_.advance(config_.sub_step_s, state_.sim_time_s, state_.weather, state_.vehicle);
+  rain_ms_ +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (!config_.simulate_water ||
       ++sub_steps_since_water_ < config_.windshield.sub_steps_per_water_step) {
     return;

@@ -7,6 +7,8 @@
 #include <memory>
 #include <vector>
 
+#include "server/sim/glass_water_map.hpp"
+#include "server/sim/rain_field.hpp"
 #include "server/sim/types.hpp"
 #include "server/sim/water.hpp"
 #include "server/sim/windshield.hpp"
@@ -14,9 +16,19 @@
 
 namespace downpour::sim {
 
+// Where the time of the last advance() went (the benchmarks report it; the state never depends on
+// it).
+struct AdvanceTiming {
+  double water_ms = 0.0;    // the windshield water's sub-steps
+  double publish_ms = 0.0;  // the metaballs and the glass water map
+  double rain_ms = 0.0;     // the rain in the air: its steps and its copy for the renderer
+};
+
 struct SimulationConfig {
   double sub_step_s = 1.0 / 240.0;  // fixed, so that lockstep runs reproduce
   WindshieldConfig windshield;
+  GlassWaterMapConfig water_map;
+  RainFieldConfig rain;
   bool simulate_water = true;  // false: the glass stays dry (tools and tests of other effects)
 };
 
@@ -31,6 +43,7 @@ struct SceneState {
   std::vector<TrafficVehicle> traffic;
   GlassConfig glass;
   WindshieldState windshield;  // published once per advance(), not per sub-step
+  RainState rain;              // likewise
 };
 
 class Simulation {
@@ -40,14 +53,22 @@ class Simulation {
   void apply(const Update& update);
   // Advances by dt in whole sub-steps; the remainder carries into the next call.
   void advance(double dt_s);
+  // The state as advance(dt_s) will leave it but for the windshield (left empty): the inputs and
+  // the time after the step, for what can be drawn while the step runs.
+  SceneState inputs_after(double dt_s) const;
 
   const SceneState& state() const { return state_; }
   const WaterSim& water() const { return water_; }
+  const RainField& rain() const { return rain_; }
+  const GlassWaterMapBuilder& water_map() const { return water_map_; }
+  const AdvanceTiming& last_advance_timing() const { return timing_; }
   // The relative air (wind minus the car's velocity) in the vehicle frame, m/s.
   glm::dvec3 air_velocity_vehicle() const;
 
  private:
   void sub_step();
+  void publish();
+  bool whole_sub_step_due(double carry_s) const;
 
   SimulationConfig config_;
   SceneState state_;
@@ -55,8 +76,12 @@ class Simulation {
   double carry_s_ = 0.0;
   WiperMotion wipers_;
   WaterSim water_;
+  RainField rain_;
+  GlassWaterMapBuilder water_map_;
   std::array<BladePose, 2> blades_at_water_step_;
   int sub_steps_since_water_ = 0;
+  AdvanceTiming timing_;
+  double rain_ms_ = 0.0;  // the rain field's time in this advance, so far
 };
 
 }  // namespace downpour::sim

@@ -24,4 +24,13 @@ std::string_view view_name(View view) {
   return "UNKNOWN";
 }
 
+ViewSpec view_spec(View view, int width, int height, std::optional<CameraPose> camera) {
+  ViewSpec spec;
+  spec.view = view;
+  spec.width = width;
+  spec.height = height;
+  spec.camera = std::move(camera);
+  return spec;
+}
+
 }  // namespace downpour::sim

@@ -78,9 +78,22 @@ struct ViewSpec {
   int width = 640;
   int height = 360;
   int jpeg_quality = 85;
-  double fov_deg = 0.0;              // 0 = the view's default
-  std::optional<CameraPose> camera;  // kRoad only; absent = chase camera
+  double fov_deg = 0.0;  // 0 = the view's default
+  // ROAD: an outside camera (absent: the chase camera). COCKPIT: a camera in the cabin instead of
+  // the driver's eye (a dash camera).
+  std::optional<CameraPose> camera;
+  // The lens (beyond the paper): focus distance (m) and aperture diameter (mm); absent, the view's
+  // own: the driver's eye focused on the road through a 4 mm pupil, a camera of its own focused at
+  // 3 m through 2 mm. The water on the glass blurs over its circle of confusion; 0 mm is a pinhole.
+  std::optional<double> focus_distance_m;
+  std::optional<double> aperture_mm;
+  // The exposure (s): a rain streak is a drop's motion during it. Absent: 1/60 s.
+  std::optional<double> exposure_s;
 };
+
+// A view of this size with every other setting at its default.
+ViewSpec view_spec(View view, int width, int height,
+                   std::optional<CameraPose> camera = std::nullopt);
 
 enum class Mode { kRealtime, kLockstep };
 

@@ -1,4 +1,4 @@
-// The windshield as the water simulation and the renderer both see it (TECHNIQUES.md section 1):
+// The windshield as the water simulation and the renderer both see it (seed 000, section 1):
 // its geometry in glass space, the wipers, the water model's parameters with the paper's defaults,
 // and what the renderer reads each frame. Plain data, no GL.
 //
@@ -62,7 +62,7 @@ struct WiperConfig {
   // Intermittent and single wipes run at the low speed.
 };
 
-// The water model's parameters (seed 000 and TECHNIQUES.md "Beyond the paper").
+// The water model's parameters (seed 000, and what this project adds).
 struct WaterConfig {
   double cell_mm = 2.0;             // mesh model cell
   double affinity_min = 0.3;        // per-cell random affinity in [min, 1]
@@ -70,12 +70,17 @@ struct WaterConfig {
   double mobility_mm_s = 60.0;      // flow speed of a drop whose drive is twice its pinning
   double max_speed_mm_s = 400.0;
   double trail_fraction = 0.01;       // of a moving drop's mass left behind per cell moved
+  int trail_spacing_cells = 3;        // left as one trail drop every this many cells
   double trail_min_mass_mg = 0.05;    // smaller trail drops are not left
   double trail_lifetime_s = 4.0;      // a trail drop's radius shrinks to nothing over this time
   double sub_metaball_merge_s = 0.6;  // impact sub-metaballs migrate into the main one over this
   int impact_sub_metaballs = 3;
   double sub_metaball_offset = 0.9;   // initial offset, in main radii
   double sub_metaball_radius = 0.55;  // in main radii
+  // What the renderer sees of trail drops and impact sub-metaballs changes in this many steps over
+  // their lives (the sim's masses change smoothly): the glass water map is rebuilt only where
+  // something visibly changed.
+  int published_stages = 6;
   double particle_radius_mm = 1.8;    // particle model: equal particles (3.5 mg each)
   double penalty = 0.25;              // repulsion: extra push as a fraction of the overlap
   int region_particle_diameters = 4;  // particle region: blade width + this many diameters a side
@@ -94,7 +99,7 @@ struct WindshieldConfig {
   GlassConfig glass;
   WiperConfig wipers;
   WaterConfig water;
-  int sub_steps_per_water_step = 2;  // the water moves at 120 Hz with the default 240 Hz sub-step
+  int sub_steps_per_water_step = 4;  // the water moves at 60 Hz with the default 240 Hz sub-step
 };
 
 // What the renderer reads each frame.
@@ -111,15 +116,32 @@ struct BladePose {
   float width_mm = 0.0f;
 };
 
+// RGBA8 texels in rows from the glass's bottom edge (v = 0) up; texel (i, j) is centred on glass
+// point ((i + 0.5), (j + 0.5)) * texel_mm, covering the glass's bounding rectangle:
+//   r, g  the water surface normal's glass-parallel part (u, v), * 0.5 + 0.5
+//   b     the compressed height, clamped to [0, 1]
+//   a     water coverage: the threshold, anti-aliased over a texel
+struct GlassWaterMap {
+  int width = 0;
+  int height = 0;
+  double texel_mm = 2.0;
+  std::vector<std::uint8_t> rgba;
+  // Unique to this content in the process: a renderer that holds `previous_stamp` needs only rows
+  // [dirty_row_begin, dirty_row_end) to hold `stamp`.
+  std::uint64_t stamp = 0;
+  std::uint64_t previous_stamp = 0;
+  int dirty_row_begin = 0;
+  int dirty_row_end = 0;
+  double wet_fraction = 0.0;  // of the glass's texels, weighted by coverage
+
+  // Coverage in [0, 1] of the texel under a glass point (mm); 0 off the map.
+  double coverage_at(glm::dvec2 uv_mm) const;
+};
+
 struct WindshieldState {
   std::vector<Metaball> metaballs;  // mesh drops (main + sub-metaballs) and particles
   std::array<BladePose, 2> blades;
-  // Water coverage of the glass on a coarse grid, the wet fraction of each cell in 0..255,
-  // row-major from the bottom-left corner, coverage_cell_mm per cell: ground truth for stats.
-  std::vector<std::uint8_t> coverage;
-  int coverage_width = 0;
-  int coverage_height = 0;
-  double coverage_cell_mm = 4.0;
+  GlassWaterMap map;            // the water as every view samples it (glass_water_map.hpp)
   std::uint32_t drops = 0;      // mesh drops
   std::uint32_t particles = 0;  // particle model drops
   double glass_wet_fraction = 0.0;

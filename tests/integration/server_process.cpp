@@ -3,6 +3,7 @@
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <algorithm>
 
 #include <chrono>
 #include <cstdlib>
@@ -13,6 +14,11 @@
 
 namespace downpour::testing {
 
+double time_scale() {
+  const char* scale = std::getenv("DOWNPOUR_TEST_TIME_SCALE");
+  return scale ? std::max(1.0, std::atof(scale)) : 1.0;
+}
+
 ServerProcess::ServerProcess(std::vector<std::string> extra_args) {
   const char* binary = std::getenv("DOWNPOUR_SERVER");
   if (!binary) throw std::runtime_error("DOWNPOUR_SERVER is not set");
@@ -20,8 +26,12 @@ ServerProcess::ServerProcess(std::vector<std::string> extra_args) {
   if (!mkdtemp(tmpl)) throw std::runtime_error("mkdtemp failed");
   dir_ = tmpl;
   const std::string port_file = dir_ + "/port";
-  std::vector<std::string> args = {binary,    "--listen",    "127.0.0.1:0", "--port-file",
-                                   port_file, "--log-level", "warn"};
+  std::vector<std::string> args = {binary, "--port-file", port_file, "--log-level", "warn"};
+  // A free port on loopback, unless the test listens elsewhere.
+  if (std::find(extra_args.begin(), extra_args.end(), "--listen") == extra_args.end()) {
+    args.push_back("--listen");
+    args.push_back("127.0.0.1:0");
+  }
   args.insert(args.end(), extra_args.begin(), extra_args.end());
   pid_ = fork();
   if (pid_ == 0) {
@@ -64,6 +74,15 @@ long ServerProcess::rss_kib() const {
 int ServerProcess::stop(double timeout_s) {
   if (pid_ <= 0) return -1;
   kill(pid_, SIGTERM);
+  return wait(timeout_s);
+}
+
+void ServerProcess::signal(int number) const {
+  if (pid_ > 0) kill(pid_, number);
+}
+
+int ServerProcess::wait(double timeout_s) {
+  if (pid_ <= 0) return -1;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   int status = 0;
   while (std::chrono::steady_clock::now() < deadline) {

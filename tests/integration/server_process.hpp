@@ -12,6 +12,10 @@
 
 namespace downpour::testing {
 
+// How much slower than a normal build the server under test may be (DOWNPOUR_TEST_TIME_SCALE;
+// the sanitizer runs set it), for the tests' bounds on wall time.
+double time_scale();
+
 class ServerProcess {
  public:
   explicit ServerProcess(std::vector<std::string> extra_args = {});
@@ -24,6 +28,9 @@ class ServerProcess {
   long rss_kib() const;
   // SIGTERM, then wait up to timeout_s; returns the exit status, or -1 if it had to be killed.
   int stop(double timeout_s = 15.0);
+  void signal(int number) const;
+  // Waits up to timeout_s for the process to exit (then kills it); as stop().
+  int wait(double timeout_s);
 
  private:
   pid_t pid_ = -1;

@@ -1,9 +1,15 @@
 // The real server binary driven by a scripted C++ client: sessions in both modes, decoded JPEGs,
 // lockstep determinism, bad input, slow readers, shutdown.
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <csignal>
+#include <iostream>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -11,6 +17,7 @@
 
 #include "downpour/v1/downpour.grpc.pb.h"
 #include "grpc_health/v1/health.grpc.pb.h"
+#include "tests/integration/requests.hpp"
 #include "tests/integration/server_process.hpp"
 
 namespace downpour::testing {
@@ -34,6 +41,38 @@ class ServerEnvironment : public ::testing::Environment {
 };
 const auto* const g_env = ::testing::AddGlobalTestEnvironment(new ServerEnvironment);
 
+// Sends n Steps of 0.1 s to a lockstep session at once, each call with this deadline, and waits
+// for them all; returns how many ended with DEADLINE_EXCEEDED.
+int send_expiring_steps(Downpour::Stub& stub, const std::string& id, int n,
+                        std::chrono::milliseconds deadline) {
+  struct Call {
+    grpc::ClientContext ctx;
+    v1::StepRequest req;
+    v1::StepResponse resp;
+  };
+  std::vector<std::unique_ptr<Call>> calls;
+  std::mutex mutex;
+  std::condition_variable cv;
+  int finished = 0, expired = 0;
+  for (int i = 0; i < n; ++i) {
+    auto c = std::make_unique<Call>();
+    c->ctx.set_deadline(std::chrono::system_clock::now() + deadline);
+    c->req.set_session_id(id);
+    *c->req.mutable_update() = drive_update(0.1 * (i + 1));
+    c->req.set_dt_s(0.1);
+    stub.async()->Step(&c->ctx, &c->req, &c->resp, [&](grpc::Status s) {
+      std::lock_guard lock(mutex);
+      ++finished;
+      if (s.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED) ++expired;
+      cv.notify_all();
+    });
+    calls.push_back(std::move(c));
+  }
+  std::unique_lock lock(mutex);
+  cv.wait(lock, [&] { return finished == n; });
+  return expired;
+}
+
 struct Decoded {
   int width = 0;
   int height = 0;
@@ -51,31 +90,6 @@ Decoded decode(const std::string& jpeg) {
   }
   tjDestroy(h);
   return d;
-}
-
-v1::ViewSpec view(v1::View v, int w, int h) {
-  v1::ViewSpec s;
-  s.set_view(v);
-  s.set_width(w);
-  s.set_height(h);
-  s.set_jpeg_quality(80);
-  return s;
-}
-
-// An update that moves the vehicle along +x at 20 m/s in rain.
-v1::Update drive_update(double t) {
-  v1::Update u;
-  u.set_sim_time_s(t);
-  auto* v = u.mutable_vehicle();
-  v->mutable_position_m()->set_x(20.0 * t);
-  v->mutable_position_m()->set_y(-5.25);
-  v->mutable_velocity_mps()->set_x(20.0);
-  auto* w = u.mutable_weather();
-  w->set_rain_rate_mm_h(10.0);
-  w->set_cloudiness(0.8);
-  w->set_sun_altitude_deg(35.0);
-  u.mutable_wipers()->set_mode(v1::WIPER_LOW);
-  return u;
 }
 
 class ServerTest : public ::testing::Test {
@@ -150,21 +164,28 @@ TEST_F(ServerTest, LockstepStepReturnsDecodableFramesInOrder) {
   close(id);
 }
 
+// The same seed and inputs give the same frames: the driver's view and the rain in the air.
 TEST_F(ServerTest, LockstepIsDeterministicForTheSameSeedAndInputs) {
   auto run = [&](std::uint64_t seed, double offset) {
-    const std::string id = create(v1::MODE_LOCKSTEP, {view(v1::VIEW_COCKPIT, 160, 90)}, seed);
+    const std::string id = create(
+        v1::MODE_LOCKSTEP, {view(v1::VIEW_COCKPIT, 160, 90), view(v1::VIEW_RAIN, 160, 90)}, seed);
     std::vector<std::string> jpegs;
     for (int i = 1; i <= 3; ++i) {
       v1::StepResponse resp;
       EXPECT_TRUE(step(id, i * 0.1 + offset, 0.1, &resp).ok());
-      jpegs.push_back(resp.frames(0).jpeg());
+      for (const v1::Frame& f : resp.frames()) {
+        jpegs.push_back(f.jpeg());
+        if (f.view() == v1::VIEW_RAIN) {
+          EXPECT_GT(f.stats().rain_streaks(), 0u);
+        }
+      }
     }
     close(id);
     return jpegs;
   };
   const auto a = run(42, 0.0);
   const auto b = run(42, 0.0);
-  ASSERT_EQ(a.size(), 3u);
+  ASSERT_EQ(a.size(), 6u);
   EXPECT_EQ(a, b);
   const auto moved = run(42, 1.0);  // other inputs: the vehicle 20 m further on
   EXPECT_NE(a, moved);
@@ -202,6 +223,112 @@ TEST_F(ServerTest, DriveLockstepAnswersEachStepOnceInOrder) {
   std::vector<std::uint64_t> expected(steps);
   for (int i = 0; i < steps; ++i) expected[i] = i + 1;
   EXPECT_EQ(numbers, expected);
+  close(id);
+}
+
+// A lockstep Drive stream whose reader pauses while its session is closed still ends with a
+// status: the responses already made arrive, then the close, not a hang until the deadline.
+TEST_F(ServerTest, DriveEndsWithAStatusWhenItsSessionClosesWhileTheReaderPauses) {
+  const std::string id = create(
+      v1::MODE_LOCKSTEP, {view(v1::VIEW_COCKPIT, 1280, 720), view(v1::VIEW_ROAD, 1280, 720)});
+  // Its own connection with a small, fixed flow-control window: the server's writes stall.
+  grpc::ChannelArguments args;
+  args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
+  args.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 64 * 1024);
+  args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
+  auto slow_stub = Downpour::NewStub(
+      grpc::CreateCustomChannel(g_server->target(), grpc::InsecureChannelCredentials(), args));
+  grpc::ClientContext ctx;
+  ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+  auto stream = slow_stub->Drive(&ctx);
+  for (int i = 0; i < 12; ++i) {
+    v1::DriveRequest req;
+    if (i == 0) req.set_session_id(id);
+    *req.mutable_update() = drive_update(i * 0.1);
+    req.set_dt_s(0.1);
+    if (!stream->Write(req)) break;
+  }
+  stream->WritesDone();
+  std::this_thread::sleep_for(std::chrono::seconds(3));  // the reader pauses
+  close(id);
+  const auto t0 = std::chrono::steady_clock::now();
+  v1::DriveResponse resp;
+  int responses = 0;
+  while (stream->Read(&resp)) ++responses;
+  const grpc::Status status = stream->Finish();
+  const double waited =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_LT(waited, 20.0) << "the stream hung after " << responses << " responses";
+  EXPECT_LE(responses, 12);
+  if (responses < 12) {
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::ABORTED) << status.error_message();
+    EXPECT_NE(status.error_message().find("closed"), std::string::npos) << status.error_message();
+  }
+}
+
+// A lockstep Drive stream with no step waiting still hears that its session was closed.
+TEST_F(ServerTest, IdleLockstepDriveEndsWhenItsSessionCloses) {
+  const std::string id = create(v1::MODE_LOCKSTEP, {view(v1::VIEW_RAIN, 32, 32)});
+  grpc::ClientContext ctx;
+  ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+  auto stream = stub->Drive(&ctx);
+  v1::DriveRequest req;
+  req.set_session_id(id);
+  req.set_dt_s(0.1);
+  *req.mutable_update() = drive_update(0.1);
+  ASSERT_TRUE(stream->Write(req));
+  v1::DriveResponse resp;
+  ASSERT_TRUE(stream->Read(&resp));  // its one step answered; the stream stays open
+  close(id);
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_FALSE(stream->Read(&resp));
+  const grpc::Status status = stream->Finish();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::ABORTED);  // it had not half-closed
+  EXPECT_NE(status.error_message().find("was closed"), std::string::npos) << status.error_message();
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+}
+
+// Steps whose calls time out before they start are dropped: they do not hold the queue, and a
+// later step is answered at once instead of after all of them.
+TEST_F(ServerTest, StepsWhoseCallsExpireAreDroppedBeforeRendering) {
+  const std::string id = create(
+      v1::MODE_LOCKSTEP, {view(v1::VIEW_COCKPIT, 1280, 720), view(v1::VIEW_ROAD, 1280, 720)});
+  v1::StepResponse first;
+  ASSERT_TRUE(step(id, 0.0, 0.1, &first).ok());  // warm: the targets exist
+  const int n = 30;
+  const int expired = send_expiring_steps(*stub, id, n, std::chrono::milliseconds(300));
+  EXPECT_GT(expired, n / 2);
+  // The expired steps are answered and forgotten without another call to push them out: the
+  // session's count of dropped steps settles on its own.
+  const auto cancelled_now = [&] {
+    grpc::ClientContext list_ctx;
+    v1::ListSessionsResponse sessions;
+    EXPECT_TRUE(stub->ListSessions(&list_ctx, v1::ListSessionsRequest(), &sessions).ok());
+    for (const auto& info : sessions.sessions()) {
+      if (info.session_id() == id) return static_cast<int>(info.steps_cancelled());
+    }
+    return -1;
+  };
+  int cancelled = cancelled_now();
+  for (int i = 0; i < 100 && cancelled < n / 2; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    cancelled = cancelled_now();
+  }
+  EXPECT_GE(cancelled, n / 2);
+  // The next step waits for at most the one step already started, not for the expired ones.
+  const auto t0 = std::chrono::steady_clock::now();
+  v1::StepResponse next;
+  const grpc::Status s = step(id, 10.0, 0.1, &next);
+  const double waited =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(s.ok()) << s.error_message();
+  ASSERT_EQ(next.frames_size(), 2);
+  // The session advanced only by the steps that ran: those started before their deadline (how
+  // many depends on the build's speed) and none of the dropped ones.
+  const int ran = static_cast<int>(std::lround(next.frames(0).sim_time_s() / 0.1)) - 2;
+  EXPECT_LT(ran, n / 2) << expired << " expired, waited " << waited << " s";
+  EXPECT_LT(waited, 2.0) << ran << " steps ran";
+  EXPECT_EQ(cancelled_now(), n - ran);
   close(id);
 }
 
@@ -379,6 +506,328 @@ TEST_F(ServerTest, StalledReaderNeitherGrowsMemoryNorSlowsAnotherSession) {
   stalled_ctx.TryCancel();
   close(rt);
   close(ls);
+}
+
+// A second server with a 1 s idle lease: a session no client talks to closes (its watchers' streams
+// end), one its simulator keeps updating or holds a Drive stream on stays, and is closed once that
+// stream ends and the lease runs out.
+TEST(IdleServerTest, SessionsNoClientIsHeardForCloseAndTheOthersStay) {
+  ServerProcess server({"--session-idle-timeout-s", "1"});
+  auto stub = Downpour::NewStub(server.channel());
+  auto create = [&](v1::Mode mode) {
+    v1::CreateSessionRequest req;
+    *req.add_views() = view(v1::VIEW_RAIN, 32, 32);
+    req.set_mode(mode);
+    req.set_fps(mode == v1::MODE_REALTIME ? 10.0 : 0.0);
+    *req.mutable_initial() = drive_update(0.0);
+    grpc::ClientContext ctx;
+    v1::SessionInfo info;
+    EXPECT_TRUE(stub->CreateSession(&ctx, req, &info).ok());
+    return info.session_id();
+  };
+  auto update = [&](const std::string& id) {
+    grpc::ClientContext ctx;
+    v1::UpdateRequest req;
+    req.set_session_id(id);
+    *req.mutable_update() = drive_update(0.0);
+    v1::UpdateResponse resp;
+    return stub->Update(&ctx, req, &resp);
+  };
+  auto listed = [&] {
+    grpc::ClientContext ctx;
+    v1::ListSessionsResponse resp;
+    EXPECT_TRUE(stub->ListSessions(&ctx, v1::ListSessionsRequest(), &resp).ok());
+    std::map<std::string, double> idle;
+    for (const auto& s : resp.sessions()) idle[s.session_id()] = s.idle_s();
+    return idle;
+  };
+
+  const std::string quiet = create(v1::MODE_REALTIME);
+  const std::string updated = create(v1::MODE_REALTIME);
+  const std::string driven = create(v1::MODE_LOCKSTEP);
+  grpc::ClientContext watch_ctx;
+  v1::WatchFramesRequest watch;
+  watch.set_session_id(quiet);
+  auto watcher = stub->WatchFrames(&watch_ctx, watch);  // a watcher does not hold the session
+  grpc::ClientContext drive_ctx;
+  auto drive = stub->Drive(&drive_ctx);
+  v1::DriveRequest first;
+  first.set_session_id(driven);
+  *first.mutable_update() = drive_update(0.0);
+  ASSERT_TRUE(drive->Write(first));  // dt_s 0: binds the stream, no frame to wait for
+
+  for (int i = 0; i < 10; ++i) {
+    ASSERT_TRUE(update(updated).ok()) << "update " << i;
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  }
+  auto idle = listed();
+  EXPECT_FALSE(idle.count(quiet)) << "a session nobody talked to for 3 s stayed";
+  ASSERT_TRUE(idle.count(updated));
+  ASSERT_TRUE(idle.count(driven));
+  EXPECT_LT(idle[updated], 0.9);
+  EXPECT_EQ(idle[driven], 0.0);
+  EXPECT_EQ(update(quiet).error_code(), grpc::StatusCode::NOT_FOUND);
+  v1::Frame frame;
+  while (watcher->Read(&frame)) {
+  }
+  EXPECT_TRUE(watcher->Finish().ok());  // the watcher's stream ended with the session
+
+  // The simulator hangs up: its session goes once the lease runs out.
+  ASSERT_TRUE(drive->WritesDone());
+  v1::DriveResponse response;
+  while (drive->Read(&response)) {
+  }
+  EXPECT_TRUE(drive->Finish().ok());
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  idle = listed();
+  EXPECT_FALSE(idle.count(driven));
+  EXPECT_FALSE(idle.count(updated));  // no longer updated either
+  grpc::ClientContext stats_ctx;
+  v1::ServerStats stats;
+  ASSERT_TRUE(stub->GetStats(&stats_ctx, v1::GetStatsRequest(), &stats).ok());
+  EXPECT_EQ(stats.sessions_closed_idle(), 3u);
+  EXPECT_EQ(server.stop(15.0), 0);
+}
+
+// Admission by cost: a session that would take the server past its pixel-rate or memory budget
+// is refused up front with RESOURCE_EXHAUSTED naming the budget; closing one makes room.
+TEST(AdmissionServerTest, SessionsPastABudgetAreRefusedSayingWhichAndFitOnceRoomIsFreed) {
+  ServerProcess server({"--max-pixel-rate-mpx", "20", "--max-memory-mb", "200"});
+  auto stub = Downpour::NewStub(server.channel());
+  auto create = [&](std::vector<v1::ViewSpec> views, double fps, std::string* id) {
+    v1::CreateSessionRequest req;
+    for (auto& v : views) *req.add_views() = v;
+    req.set_mode(v1::MODE_REALTIME);
+    req.set_fps(fps);
+    grpc::ClientContext ctx;
+    v1::SessionInfo info;
+    const grpc::Status s = stub->CreateSession(&ctx, req, &info);
+    if (id) *id = info.session_id();
+    return s;
+  };
+  std::string first, second;
+  ASSERT_TRUE(create({view(v1::VIEW_COCKPIT, 640, 360)}, 30.0, &first).ok());  // 6.9 Mpx/s
+  ASSERT_TRUE(create({view(v1::VIEW_ROAD, 640, 360)}, 30.0, &second).ok());
+  grpc::Status s = create({view(v1::VIEW_RAIN, 640, 360)}, 30.0, nullptr);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_NE(s.error_message().find("pixel rate"), std::string::npos) << s.error_message();
+  // Four 4K views at 0.1 fps fit the pixel rate but not the memory.
+  s = create({view(v1::VIEW_COCKPIT, 3840, 2160), view(v1::VIEW_ROAD, 3840, 2160),
+              view(v1::VIEW_RAIN, 3840, 2160), view(v1::VIEW_WINDSHIELD, 3840, 2160)},
+             0.1, nullptr);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_NE(s.error_message().find("memory"), std::string::npos) << s.error_message();
+
+  grpc::ClientContext stats_ctx;
+  v1::ServerStats stats;
+  ASSERT_TRUE(stub->GetStats(&stats_ctx, v1::GetStatsRequest(), &stats).ok());
+  EXPECT_NEAR(stats.pixel_rate_mpx_s(), 2 * 640 * 360 * 30 / 1e6, 0.01);
+  EXPECT_DOUBLE_EQ(stats.pixel_rate_budget_mpx_s(), 20.0);
+  EXPECT_DOUBLE_EQ(stats.memory_budget_mib(), 200.0);
+  EXPECT_GT(stats.memory_estimate_mib(), 0.0);
+
+  grpc::ClientContext close_ctx;
+  v1::CloseSessionRequest close;
+  close.set_session_id(first);
+  v1::CloseSessionResponse closed;
+  ASSERT_TRUE(stub->CloseSession(&close_ctx, close, &closed).ok());
+  EXPECT_TRUE(create({view(v1::VIEW_RAIN, 640, 360)}, 30.0, nullptr).ok());
+  EXPECT_EQ(server.stop(15.0), 0);
+}
+
+// A frame far over any budget (four 3840x2160 views on llvmpipe) holds the render loop: with a
+// 0.2 s watchdog, health turns NOT_SERVING while it renders and SERVING again once it is done.
+TEST(WatchdogTest, HealthIsNotServingWhileTheRenderLoopIsHeldAndServingAfter) {
+  ServerProcess server(
+      {"--watchdog-s", "0.2", "--max-memory-mb", "-1", "--max-pixel-rate-mpx", "-1"});
+  auto stub = Downpour::NewStub(server.channel());
+  auto health = grpc::health::v1::Health::NewStub(server.channel());
+  auto status = [&] {
+    grpc::ClientContext ctx;
+    grpc::health::v1::HealthCheckResponse h;
+    const grpc::Status s = health->Check(&ctx, grpc::health::v1::HealthCheckRequest(), &h);
+    EXPECT_TRUE(s.ok()) << s.error_message();
+    return h.status();
+  };
+  EXPECT_EQ(status(), grpc::health::v1::HealthCheckResponse::SERVING);
+  v1::CreateSessionRequest create;
+  for (const auto v : {v1::VIEW_COCKPIT, v1::VIEW_ROAD, v1::VIEW_RAIN, v1::VIEW_WINDSHIELD})
+    *create.add_views() = view(v, 3840, 2160);
+  create.set_mode(v1::MODE_LOCKSTEP);
+  *create.mutable_initial() = drive_update(0.0);
+  v1::SessionInfo info;
+  {
+    grpc::ClientContext ctx;
+    ASSERT_TRUE(stub->CreateSession(&ctx, create, &info).ok());
+  }
+  std::atomic<bool> stepped{false};
+  double step_s = 0.0;
+  std::thread step_thread([&] {
+    const auto t0 = std::chrono::steady_clock::now();
+    grpc::ClientContext ctx;
+    v1::StepRequest req;
+    req.set_session_id(info.session_id());
+    *req.mutable_update() = drive_update(0.1);
+    req.set_dt_s(0.1);
+    v1::StepResponse resp;
+    EXPECT_TRUE(stub->Step(&ctx, req, &resp).ok());
+    step_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    stepped = true;
+  });
+  bool saw_not_serving = false;
+  while (!stepped) {
+    saw_not_serving |= status() == grpc::health::v1::HealthCheckResponse::NOT_SERVING;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  step_thread.join();
+  // Held for well over the watchdog plus its polling (0.25 s): it must have been seen.
+  if (step_s > 0.7) {
+    EXPECT_TRUE(saw_not_serving) << "the step held the loop for " << step_s << " s";
+  } else {
+    std::cout << "the 4K step took only " << step_s << " s: the watchdog was not exercised\n";
+  }
+  bool serving_again = false;
+  for (int i = 0; i < 40 && !serving_again; ++i) {
+    serving_again = status() == grpc::health::v1::HealthCheckResponse::SERVING;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_TRUE(serving_again);
+  EXPECT_EQ(server.stop(15.0), 0);
+}
+
+// SIGTERM drains: health goes NOT_SERVING and new sessions are refused with UNAVAILABLE, the steps
+// already accepted are answered, then every stream ends with UNAVAILABLE, and the process exits 0
+// well within its grace.
+TEST(DrainTest, SigtermAnswersTheStepsInFlightEndsStreamsWithUnavailableAndExitsInTime) {
+  ServerProcess server({"--shutdown-grace-s", "10"});
+  auto stub = Downpour::NewStub(server.channel());
+  auto create = [&](v1::Mode mode, std::vector<v1::ViewSpec> views) {
+    v1::CreateSessionRequest req;
+    for (auto& v : views) *req.add_views() = v;
+    req.set_mode(mode);
+    req.set_fps(mode == v1::MODE_REALTIME ? 10.0 : 0.0);
+    *req.mutable_initial() = drive_update(0.0);
+    grpc::ClientContext ctx;
+    v1::SessionInfo info;
+    const grpc::Status s = stub->CreateSession(&ctx, req, &info);
+    EXPECT_TRUE(s.ok()) << s.error_message();
+    return info.session_id();
+  };
+  const std::string driven =
+      create(v1::MODE_LOCKSTEP, {view(v1::VIEW_COCKPIT, 640, 360), view(v1::VIEW_ROAD, 640, 360)});
+  const std::string stepped = create(v1::MODE_LOCKSTEP, {view(v1::VIEW_COCKPIT, 1280, 720)});
+  const std::string watched = create(v1::MODE_REALTIME, {view(v1::VIEW_RAIN, 64, 64)});
+
+  grpc::ClientContext watch_ctx;
+  v1::WatchFramesRequest watch;
+  watch.set_session_id(watched);
+  auto watcher = stub->WatchFrames(&watch_ctx, watch);
+  v1::Frame frame;
+  ASSERT_TRUE(watcher->Read(&frame));
+
+  // Four Drive steps: once the first is answered the other three have been accepted.
+  grpc::ClientContext drive_ctx;
+  auto drive = stub->Drive(&drive_ctx);
+  for (int i = 0; i < 4; ++i) {
+    v1::DriveRequest req;
+    if (i == 0) req.set_session_id(driven);
+    *req.mutable_update() = drive_update(i * 0.1);
+    req.set_dt_s(0.1);
+    ASSERT_TRUE(drive->Write(req));
+  }
+  v1::DriveResponse response;
+  ASSERT_TRUE(drive->Read(&response));
+  int drive_responses = 1;
+
+  // A unary step in flight when the signal comes.
+  grpc::Status step_status;
+  int step_frames = 0;
+  std::thread step_thread([&] {
+    grpc::ClientContext ctx;
+    ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+    v1::StepRequest req;
+    req.set_session_id(stepped);
+    *req.mutable_update() = drive_update(0.0);
+    req.set_dt_s(0.1);
+    v1::StepResponse resp;
+    step_status = stub->Step(&ctx, req, &resp);
+    step_frames = resp.frames_size();
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+
+  const auto t0 = std::chrono::steady_clock::now();
+  server.signal(SIGTERM);
+  // Health turns NOT_SERVING at once (or the server is already gone).
+  auto health = grpc::health::v1::Health::NewStub(server.channel());
+  for (int i = 0; i < 500; ++i) {
+    grpc::ClientContext ctx;
+    grpc::health::v1::HealthCheckResponse h;
+    const grpc::Status s = health->Check(&ctx, grpc::health::v1::HealthCheckRequest(), &h);
+    if (!s.ok() || h.status() != grpc::health::v1::HealthCheckResponse::SERVING) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  {
+    // Refused from now on (by the draining server, or by no server once it is gone).
+    grpc::ClientContext ctx;
+    v1::CreateSessionRequest req;
+    *req.add_views() = view(v1::VIEW_RAIN, 32, 32);
+    v1::SessionInfo info;
+    EXPECT_EQ(stub->CreateSession(&ctx, req, &info).error_code(), grpc::StatusCode::UNAVAILABLE);
+  }
+  while (drive->Read(&response)) ++drive_responses;
+  const grpc::Status drive_status = drive->Finish();
+  EXPECT_EQ(drive_responses, 4) << "each step accepted before the signal is answered";
+  EXPECT_EQ(drive_status.error_code(), grpc::StatusCode::UNAVAILABLE)
+      << drive_status.error_message();
+  EXPECT_NE(drive_status.error_message().find("shutting down"), std::string::npos)
+      << drive_status.error_message();
+  step_thread.join();
+  EXPECT_TRUE(step_status.ok()) << step_status.error_message();
+  EXPECT_EQ(step_frames, 1);
+  while (watcher->Read(&frame)) {
+  }
+  const grpc::Status watch_status = watcher->Finish();
+  EXPECT_EQ(watch_status.error_code(), grpc::StatusCode::UNAVAILABLE)
+      << watch_status.error_message();
+  EXPECT_EQ(server.wait(15.0), 0);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 10.0);
+}
+
+// Steps whose calls expired while queued are not in flight: a drain does not wait for them.
+TEST(DrainTest, StepsWhoseCallsExpiredDoNotHoldTheDrain) {
+  ServerProcess server({"--shutdown-grace-s", "20"});
+  auto stub = Downpour::NewStub(server.channel());
+  v1::CreateSessionRequest create;
+  *create.add_views() = view(v1::VIEW_COCKPIT, 1280, 720);
+  *create.add_views() = view(v1::VIEW_ROAD, 1280, 720);
+  create.set_mode(v1::MODE_LOCKSTEP);
+  *create.mutable_initial() = drive_update(0.0);
+  v1::SessionInfo info;
+  {
+    grpc::ClientContext ctx;
+    ASSERT_TRUE(stub->CreateSession(&ctx, create, &info).ok());
+  }
+  send_expiring_steps(*stub, info.session_id(), 20, std::chrono::milliseconds(200));
+  // Let the steps that started before their deadline finish rendering.
+  std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(1500 * time_scale())));
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(server.stop(25.0), 0);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+            2.0 * time_scale());
+}
+
+// With nothing in flight the server is gone within a second of SIGTERM, client connections open
+// or not.
+TEST(DrainTest, ExitsWithinASecondWhileIdleConnectionsStayOpen) {
+  ServerProcess server;
+  auto stub = Downpour::NewStub(server.channel());
+  grpc::ClientContext ctx;
+  v1::ListSessionsResponse sessions;
+  ASSERT_TRUE(stub->ListSessions(&ctx, v1::ListSessionsRequest(), &sessions).ok());
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(server.stop(15.0), 0);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+            1.0 * time_scale());
 }
 
 }  // namespace

@@ -48,6 +48,11 @@ class ClientTest(unittest.TestCase):
         self.assertEqual((spec.view, spec.width, spec.height, spec.jpeg_quality),
                          (pb.VIEW_COCKPIT, 640, 360, 85))
         self.assertFalse(spec.HasField("camera_position_m"))
+        self.assertFalse(spec.HasField("focus_distance_m"))
+        self.assertFalse(spec.HasField("aperture_mm"))
+        dash = view_spec("COCKPIT", 64, 48, focus_distance_m=0.8, aperture_mm=0)
+        self.assertEqual((dash.focus_distance_m, dash.aperture_mm), (0.8, 0.0))
+        self.assertTrue(dash.HasField("aperture_mm"))  # 0 (a pinhole) is set, not left out
         road = view_spec("VIEW_ROAD", 16, 16, camera_position_m=(1, 2, 3))
         self.assertEqual((road.view, road.camera_position_m.z), (pb.VIEW_ROAD, 3.0))
         self.assertEqual(view_spec(42, 16, 16).view, 42)  # raw numbers pass unchecked

@@ -123,6 +123,20 @@ class InterpolationTest(unittest.TestCase):
                          [(pb.VIEW_COCKPIT, 160, 90, 80), (pb.VIEW_ROAD, 128, 72, 0)])
         self.assertEqual(request.initial, self.scenario.at(0.0))
         self.assertEqual(request.initial.weather.rain_rate_mm_h, 10.0)
+        for view in request.views:  # no lens in the file: left unset, the view's own
+            self.assertFalse(view.HasField("focus_distance_m"))
+            self.assertFalse(view.HasField("aperture_mm"))
+
+    def test_lens_per_view(self):
+        data = scenario_data()
+        data["views"][0].update(focus_distance_m=0.5, aperture_mm=0)
+        data["views"][1].update(aperture_mm=8, exposure_s=0.004)
+        cockpit, road = Scenario(data).create_request().views
+        self.assertEqual((cockpit.focus_distance_m, cockpit.aperture_mm), (0.5, 0.0))
+        self.assertTrue(cockpit.HasField("aperture_mm"))  # 0 is a pinhole, not absent
+        self.assertFalse(cockpit.HasField("exposure_s"))
+        self.assertFalse(road.HasField("focus_distance_m"))
+        self.assertEqual((road.aperture_mm, road.exposure_s), (8.0, 0.004))
 
     def test_load_from_file(self):
         with tempfile.TemporaryDirectory() as folder:
@@ -161,6 +175,12 @@ class ValidationTest(unittest.TestCase):
         self.assert_rejected(lambda d: d["views"][0].update(height=9.5), "views[0].height")
         self.assert_rejected(lambda d: d["views"][0].update(jpeg_quality=101),
                              "views[0].jpeg_quality")
+        for bad in (0.01, 20000, -1, math.nan, math.inf, "3", True):
+            self.assert_rejected(lambda d: d["views"][1].update(focus_distance_m=bad),
+                                 "views[1].focus_distance_m")
+        for bad in (-0.5, 80, math.nan, -math.inf, None):
+            self.assert_rejected(lambda d: d["views"][0].update(aperture_mm=bad),
+                                 "views[0].aperture_mm")
 
     def test_keyframes(self):
         self.assert_rejected(lambda d: d["keyframes"][1].update(t=6.0), "keyframes[2].t")

@@ -19,7 +19,7 @@ class RenderTest : public ::testing::Test {
   static void TearDownTestSuite() { renderer_.reset(); }
 
   static sim::ViewSpec view_spec(sim::View view, int width, int height) {
-    return {view, width, height, 85, 0.0, std::nullopt};
+    return sim::view_spec(view, width, height);
   }
   static RgbaImage render(const sim::ViewSpec& spec, const sim::SceneState& scene) {
     return {spec.width, spec.height, render::render_image(*renderer_, spec, scene)};
@@ -27,13 +27,21 @@ class RenderTest : public ::testing::Test {
   static render::Renderer& renderer() { return *renderer_; }
 
   // The highway scene with dry glass, its water not simulated: for tests that bring their own.
+  // No streaks in the air either: these tests measure the glass against a still background.
   static const sim::SceneState& dry_scene() {
-    static const sim::SceneState scene = highway_scene(25.0, 0.95, false);
+    static const sim::SceneState scene = [] {
+      sim::SceneState s = highway_scene(25.0, 0.95, false);
+      s.rain.drops.clear();
+      s.rain.splashes.clear();
+      return s;
+    }();
     return scene;
   }
+  // The dry scene with this water on its glass (its glass water map built from the metaballs).
   static RgbaImage render_water(const sim::WindshieldState& water, const sim::ViewSpec& spec) {
     sim::SceneState scene = dry_scene();
     scene.windshield = water;
+    build_water_map(scene.windshield, scene.glass);
     return render(spec, scene);
   }
 

@@ -109,11 +109,6 @@ TEST_F(RendererTest, DryWindshieldViewIsTheOutlineOnBlack) {
   EXPECT_LT(lit, total / 10);   // and nothing else: no water on dry glass
 }
 
-TEST_F(RendererTest, RainViewIsBlackWithoutRainEffects) {
-  const RgbaImage image = render(sim::View::kRain, highway_scene());
-  EXPECT_LT(testing::mean_luma(image), 0.01);
-}
-
 TEST_F(RendererTest, SameSceneRendersTheSamePixels) {
   const sim::SceneState scene = highway_scene();
   EXPECT_EQ(render(sim::View::kCockpit, scene).pixels, render(sim::View::kCockpit, scene).pixels);

@@ -1,5 +1,5 @@
-// The fraction of a COCKPIT view hidden by water, from the coverage grid: none without water, all
-// of it through a glass wholly wet, about half through a glass wet on one side.
+// The fraction of a COCKPIT view hidden by water, from the glass water map's coverage: none without
+// water, all of it through a glass wholly wet, about half through a glass wet on one side.
 #include "server/render/view_wet_fraction.hpp"
 
 #include <gtest/gtest.h>
@@ -9,19 +9,19 @@
 namespace downpour::render {
 namespace {
 
-// A coverage grid over the default glass, each cell's wet fraction from a function of u (mm).
+// A glass water map over the default glass, each texel's coverage from a function of u (mm).
 template <typename Fn>
 sim::SceneState scene_with_coverage(Fn&& wet_fraction_at_u) {
   sim::SceneState scene;
-  sim::WindshieldState& w = scene.windshield;
-  w.coverage_cell_mm = 4.0;
-  w.coverage_width = static_cast<int>(scene.glass.bottom_width_mm / w.coverage_cell_mm);
-  w.coverage_height = static_cast<int>(scene.glass.height_mm / w.coverage_cell_mm) + 1;
-  w.coverage.resize(static_cast<std::size_t>(w.coverage_width) * w.coverage_height);
-  for (int y = 0; y < w.coverage_height; ++y) {
-    for (int x = 0; x < w.coverage_width; ++x) {
-      const double u = (x + 0.5) * w.coverage_cell_mm;
-      w.coverage[static_cast<std::size_t>(y) * w.coverage_width + x] =
+  sim::GlassWaterMap& map = scene.windshield.map;
+  map.texel_mm = 2.0;
+  map.width = static_cast<int>(scene.glass.bottom_width_mm / map.texel_mm);
+  map.height = static_cast<int>(scene.glass.height_mm / map.texel_mm) + 1;
+  map.rgba.assign(static_cast<std::size_t>(map.width) * map.height * 4, 0);
+  for (int y = 0; y < map.height; ++y) {
+    for (int x = 0; x < map.width; ++x) {
+      const double u = (x + 0.5) * map.texel_mm;
+      map.rgba[(static_cast<std::size_t>(y) * map.width + x) * 4 + 3] =
           static_cast<std::uint8_t>(255.0 * wet_fraction_at_u(u) + 0.5);
     }
   }
@@ -29,13 +29,15 @@ sim::SceneState scene_with_coverage(Fn&& wet_fraction_at_u) {
 }
 
 sim::ViewSpec dash_view(double fov_deg = 40.0) {
-  return {sim::View::kCockpit, 640, 360, 85, fov_deg, dash_camera_pose()};
+  sim::ViewSpec spec = sim::view_spec(sim::View::kCockpit, 640, 360, dash_camera_pose());
+  spec.fov_deg = fov_deg;
+  return spec;
 }
-sim::ViewSpec driver_view() { return {sim::View::kCockpit, 640, 360, 85, 0.0, std::nullopt}; }
+sim::ViewSpec driver_view() { return sim::view_spec(sim::View::kCockpit, 640, 360); }
 
 TEST(ViewWetFraction, NoWaterHidesNothing) {
   EXPECT_EQ(view_wet_fraction(driver_view(), scene_with_coverage([](double) { return 0.0; })), 0.0);
-  EXPECT_EQ(view_wet_fraction(driver_view(), sim::SceneState{}), 0.0);  // no grid yet
+  EXPECT_EQ(view_wet_fraction(driver_view(), sim::SceneState{}), 0.0);  // no map yet
 }
 
 TEST(ViewWetFraction, AWetGlassHidesWhatIsSeenThroughIt) {
@@ -61,7 +63,7 @@ TEST(ViewWetFraction, HalfAGlassHidesAboutHalf) {
 TEST(ViewWetFraction, OnlyTheCockpitLooksThroughTheGlass) {
   const sim::SceneState wet = scene_with_coverage([](double) { return 1.0; });
   for (sim::View view : {sim::View::kRoad, sim::View::kWindshield, sim::View::kRain}) {
-    EXPECT_EQ(view_wet_fraction({view, 640, 360, 85, 0.0, std::nullopt}, wet), 0.0);
+    EXPECT_EQ(view_wet_fraction(sim::view_spec(view, 640, 360), wet), 0.0);
   }
 }
 

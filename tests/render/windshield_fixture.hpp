@@ -1,6 +1,6 @@
 // Hand-made windshield water for the render tests and the render-views tool: deterministic states
 // built without the simulation (drops, trails, wiped sectors, water piled at the blades), and the
-// coverage grid that the simulation would publish with them.
+// glass water map that the simulation would publish with them.
 #pragma once
 
 #include <algorithm>
@@ -12,6 +12,7 @@
 #include <tuple>
 #include <utility>
 
+#include "server/sim/random.hpp"
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"
 #include "server/sim/windshield.hpp"
@@ -39,24 +40,6 @@ inline sim::SceneState highway_scene(double rain_mm_h = 25.0, double cloudiness 
   return simulated.emplace(key, simulation.state()).first->second;
 }
 
-// A small deterministic generator (splitmix64): the same pictures on every standard library.
-class FixtureRandom {
- public:
-  explicit FixtureRandom(std::uint64_t seed) : state_(seed) {}
-  std::uint64_t next() {
-    std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-  }
-  double uniform(double lo = 0.0, double hi = 1.0) {
-    return lo + (hi - lo) * static_cast<double>(next() >> 11) * 0x1.0p-53;
-  }
-
- private:
-  std::uint64_t state_;
-};
-
 // A blade of the default wipers (sim::WiperConfig) at an angle from +u, degrees.
 inline sim::BladePose blade_at(int index, double angle_deg) {
   const sim::BladeConfig c = sim::WiperConfig{}.blades[index];
@@ -73,51 +56,10 @@ inline std::array<sim::BladePose, 2> parked_blades() {
   return {blade_at(0, w.blades[0].park_deg), blade_at(1, w.blades[1].park_deg)};
 }
 
-// The coverage grid from the metaballs: the wet fraction of each cell (0..255) from 2 x 2 samples,
-// wet where the summed density exceeds 0.5 (the compressed density exceeds 0.5 exactly where the
-// raw one does).
-inline void fill_coverage(sim::WindshieldState& state, const sim::GlassConfig& glass) {
-  const double cell = state.coverage_cell_mm;
-  state.coverage_width = static_cast<int>(std::ceil(glass.bottom_width_mm / cell));
-  state.coverage_height = static_cast<int>(std::ceil(glass.height_mm / cell));
-  // Densities at 2 x 2 samples a cell, at quarter offsets.
-  const int sw = 2 * state.coverage_width, sh = 2 * state.coverage_height;
-  const double step = 0.5 * cell;
-  std::vector<float> density(static_cast<std::size_t>(sw) * sh);
-  for (const sim::Metaball& m : state.metaballs) {
-    const double reach = 2.5 * m.radius_mm;
-    const int x0 = std::max(0, static_cast<int>(std::floor((m.u_mm - reach) / step)));
-    const int x1 = std::min(sw - 1, static_cast<int>((m.u_mm + reach) / step));
-    const int y0 = std::max(0, static_cast<int>(std::floor((m.v_mm - reach) / step)));
-    const int y1 = std::min(sh - 1, static_cast<int>((m.v_mm + reach) / step));
-    for (int y = y0; y <= y1; ++y) {
-      for (int x = x0; x <= x1; ++x) {
-        const double du = (x + 0.5) * step - m.u_mm, dv = (y + 0.5) * step - m.v_mm;
-        const double q = (du * du + dv * dv) / (double(m.radius_mm) * m.radius_mm);
-        density[static_cast<std::size_t>(y) * sw + x] += static_cast<float>(1.0 / (1.0 + q * q));
-      }
-    }
-  }
-  state.coverage.assign(static_cast<std::size_t>(state.coverage_width) * state.coverage_height, 0);
-  double wet = 0.0;
-  int on_glass = 0;
-  for (int y = 0; y < state.coverage_height; ++y) {
-    for (int x = 0; x < state.coverage_width; ++x) {
-      int samples = 0;
-      for (int j = 0; j < 2; ++j) {
-        for (int i = 0; i < 2; ++i) {
-          samples += density[static_cast<std::size_t>(2 * y + j) * sw + 2 * x + i] > 0.5f;
-        }
-      }
-      const std::size_t c = static_cast<std::size_t>(y) * state.coverage_width + x;
-      state.coverage[c] = static_cast<std::uint8_t>(std::lround(samples * 255.0 / 4.0));
-      if (glass.contains({(x + 0.5) * cell, (y + 0.5) * cell})) {
-        ++on_glass;
-        wet += state.coverage[c] / 255.0;
-      }
-    }
-  }
-  state.glass_wet_fraction = on_glass ? wet / on_glass : 0.0;
+// The glass water map of the metaballs, as the simulation publishes it (its own builder).
+inline void build_water_map(sim::WindshieldState& state, const sim::GlassConfig& glass) {
+  sim::GlassWaterMapBuilder(glass).build(state.metaballs, state.map);
+  state.glass_wet_fraction = state.map.wet_fraction;
 }
 
 // Rain on the glass with the wipers part-way up their sweep: drops of many sizes (a main metaball,
@@ -127,7 +69,7 @@ inline void fill_coverage(sim::WindshieldState& state, const sim::GlassConfig& g
 inline sim::WindshieldState rainy_windshield(const sim::GlassConfig& glass, int metaballs,
                                              std::array<double, 2> blade_deg = {40.0, 36.0},
                                              std::uint64_t seed = 7) {
-  FixtureRandom rng(seed);
+  sim::RandomStream rng(seed, 0);  // the simulation's own generator
   sim::WindshieldState s;
   const sim::WiperConfig wipers;
   for (int i = 0; i < 2; ++i) s.blades[i] = blade_at(i, blade_deg[i]);
@@ -199,7 +141,7 @@ inline sim::WindshieldState rainy_windshield(const sim::GlassConfig& glass, int 
   s.metaballs.resize(std::min<std::size_t>(s.metaballs.size(), metaballs));
   s.particles = static_cast<std::uint32_t>(std::min(particles, s.metaballs.size()));
   s.drops = static_cast<std::uint32_t>(s.metaballs.size()) - s.particles;
-  fill_coverage(s, glass);
+  build_water_map(s, glass);
   return s;
 }
 
@@ -225,7 +167,7 @@ inline sim::WindshieldState golden_windshield(const sim::GlassConfig& glass) {
   for (int k = 0; k < 6; ++k) {
     s.metaballs.push_back({static_cast<float>(200.0 + 130.0 * k), 300.0f, 1.0f + 1.2f * k});
   }
-  fill_coverage(s, glass);
+  build_water_map(s, glass);
   return s;
 }
 

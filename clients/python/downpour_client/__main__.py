@@ -16,7 +16,7 @@ import time
 import grpc
 from google.protobuf import json_format
 
-from . import DownpourClient, Scenario
+from . import DownpourClient, Scenario, add_security_arguments, security_options
 from .messages import enum_name
 from downpour.v1 import downpour_pb2 as pb
 
@@ -141,13 +141,21 @@ def play(args):
     scenario = Scenario.load(args.scenario)
     if args.out:
         os.makedirs(args.out, exist_ok=True)
-    with DownpourClient(args.server) as client:
+    with DownpourClient(args.server, **security_options(args)) as client:
         if args.wait_ready:
             client.wait_until_serving(args.wait_ready)
         info = client.create_session_from(scenario.create_request(args.mode.upper()))
         print(f"session_id={info.session_id}", flush=True)
         player = Player(client, scenario, info.session_id, args.mode, args.out, args.frames,
                         args.duration)
+
+        # From here a signal ends the stream from another thread, and the player returns as from
+        # any end: no exception is thrown into gRPC's code, wherever the main thread is.
+        def stop_playing(signum, frame):
+            threading.Thread(target=player.stop, daemon=True).start()
+
+        signal.signal(signal.SIGTERM, stop_playing)
+        signal.signal(signal.SIGINT, stop_playing)
         try:
             player.run()
         except KeyboardInterrupt:
@@ -164,7 +172,7 @@ def play(args):
 
 
 def list_sessions(args):
-    with DownpourClient(args.server) as client:
+    with DownpourClient(args.server, **security_options(args)) as client:
         if args.wait_ready:
             client.wait_until_serving(args.wait_ready)
         for session in client.list_sessions():
@@ -172,12 +180,14 @@ def list_sessions(args):
                              for v in session.views)
             print(f"{session.session_id} mode={enum_name(pb.Mode, session.mode)} "
                   f"fps={session.fps:g} seed={session.seed} views={views} "
-                  f"frames={session.frames_rendered} sim_time_s={session.sim_time_s:.3f}")
+                  f"frames={session.frames_rendered} sim_time_s={session.sim_time_s:.3f} "
+                  f"achieved_fps={session.achieved_fps:.1f} frames_late={session.frames_late} "
+                  f"idle_s={session.idle_s:.1f}")
     return 0
 
 
 def stats(args):
-    with DownpourClient(args.server) as client:
+    with DownpourClient(args.server, **security_options(args)) as client:
         if args.wait_ready:
             client.wait_until_serving(args.wait_ready)
         print(json_format.MessageToJson(client.get_stats(), preserving_proto_field_name=True,
@@ -188,6 +198,7 @@ def stats(args):
 def build_parser():
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--server", default="127.0.0.1:50051", help="host:port of the server")
+    add_security_arguments(common)
     common.add_argument("--wait-ready", type=float, default=0.0, metavar="S",
                         help="first wait up to S seconds for the server to report SERVING")
     parser = argparse.ArgumentParser(prog="downpour_client", description=__doc__.splitlines()[0])

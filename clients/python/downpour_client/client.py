@@ -1,5 +1,7 @@
 """DownpourClient: a thin wrapper over the generated Downpour stub."""
 
+import collections
+import os
 import time
 
 import grpc
@@ -13,19 +15,95 @@ from .messages import mode_value, to_view_spec, view_value
 _MAX_MESSAGE_BYTES = 64 * 1024 * 1024
 
 
-class DownpourClient:
-    """One channel to one server. Use as a context manager to close the channel."""
+class _CallDetails(collections.namedtuple(
+        "_CallDetails", ("method", "timeout", "metadata", "credentials", "wait_for_ready",
+                         "compression")), grpc.ClientCallDetails):
+    pass
 
-    def __init__(self, target="127.0.0.1:50051", timeout_s=30.0):
+
+class _BearerToken(grpc.UnaryUnaryClientInterceptor, grpc.UnaryStreamClientInterceptor,
+                   grpc.StreamUnaryClientInterceptor, grpc.StreamStreamClientInterceptor):
+    """Sends "authorization: Bearer <token>" with every call (over TLS or plaintext loopback)."""
+
+    def __init__(self, token):
+        self._header = ("authorization", f"Bearer {token}")
+
+    def _details(self, details):
+        metadata = list(details.metadata or []) + [self._header]
+        return _CallDetails(details.method, details.timeout, metadata, details.credentials,
+                            details.wait_for_ready, details.compression)
+
+    def intercept_unary_unary(self, continuation, details, request):
+        return continuation(self._details(details), request)
+
+    def intercept_unary_stream(self, continuation, details, request):
+        return continuation(self._details(details), request)
+
+    def intercept_stream_unary(self, continuation, details, requests):
+        return continuation(self._details(details), requests)
+
+    def intercept_stream_stream(self, continuation, details, requests):
+        return continuation(self._details(details), requests)
+
+
+def _read(path):
+    with open(path, "rb") as file:
+        return file.read()
+
+
+def add_security_arguments(parser):
+    """The command-line options of a protected server (README, Exposing the server)."""
+    parser.add_argument("--token", help="bearer token (default: $DOWNPOUR_TOKEN)")
+    parser.add_argument("--tls-ca", help="CA certificate (PEM) of a TLS server "
+                                         "(default: $DOWNPOUR_TLS_CA)")
+    parser.add_argument("--tls-cert", help="this client's certificate (PEM), for mutual TLS")
+    parser.add_argument("--tls-key", help="this client's private key (PEM), for mutual TLS")
+
+
+def security_options(args):
+    """DownpourClient keyword arguments from add_security_arguments' options."""
+    return {"token": args.token, "tls_ca": args.tls_ca, "tls_cert": args.tls_cert,
+            "tls_key": args.tls_key}
+
+
+class DownpourClient:
+    """One channel to one server. Use as a context manager to close the channel.
+
+    token: the bearer token a server with a tokens file wants (default: $DOWNPOUR_TOKEN).
+    tls_ca: PEM file of the CA that signed the server's certificate: connect with TLS (default:
+    $DOWNPOUR_TLS_CA); tls_cert and tls_key: this client's certificate, for mutual TLS.
+    stream_window_kib: the most frame data gRPC takes in ahead of the reader, per stream. A
+    reader that pauses finds at most this much of old frames waiting before the latest, instead of
+    the megabytes a window grown by gRPC's bandwidth probe holds (README, Frames and flow
+    control). 0 keeps gRPC's own (faster over long, fast links).
+    """
+
+    def __init__(self, target="127.0.0.1:50051", timeout_s=30.0, token=None, tls_ca=None,
+                 tls_cert=None, tls_key=None, stream_window_kib=256):
         self.target = target
         self.timeout_s = timeout_s  # deadline of each unary call
-        self._channel = grpc.insecure_channel(target, options=[
+        token = token if token is not None else os.environ.get("DOWNPOUR_TOKEN")
+        tls_ca = tls_ca if tls_ca is not None else os.environ.get("DOWNPOUR_TLS_CA")
+        options = [
             ("grpc.max_receive_message_length", _MAX_MESSAGE_BYTES),
             ("grpc.max_send_message_length", _MAX_MESSAGE_BYTES),
             # Reconnect within a second of a server (re)start instead of backing off for minutes.
             ("grpc.initial_reconnect_backoff_ms", 100),
             ("grpc.max_reconnect_backoff_ms", 1000),
-        ])
+        ]
+        if stream_window_kib:
+            options += [("grpc.http2.bdp_probe", 0),
+                        ("grpc.http2.lookahead_bytes", int(stream_window_kib) * 1024)]
+        if tls_ca:
+            credentials = grpc.ssl_channel_credentials(
+                root_certificates=_read(tls_ca),
+                private_key=_read(tls_key) if tls_key else None,
+                certificate_chain=_read(tls_cert) if tls_cert else None)
+            self._channel = grpc.secure_channel(target, credentials, options=options)
+        else:
+            self._channel = grpc.insecure_channel(target, options=options)
+        if token:
+            self._channel = grpc.intercept_channel(self._channel, _BearerToken(token))
         self.stub = downpour_pb2_grpc.DownpourStub(self._channel)
         self._health = health_pb2_grpc.HealthStub(self._channel)
 

@@ -56,14 +56,26 @@ def rotation(yaw_pitch_roll):
 
 
 def view_spec(view, width, height, quality=0, fov_deg=0.0, camera_position_m=None,
-              camera_rotation_deg=None):
-    """A ViewSpec; camera pose (VIEW_ROAD, or a forward camera for VIEW_COCKPIT) as (x, y, z) and (yaw, pitch, roll)."""
+              camera_rotation_deg=None, focus_distance_m=None, aperture_mm=None,
+              exposure_s=None):
+    """A ViewSpec; camera pose (VIEW_ROAD, or a forward camera for VIEW_COCKPIT) as (x, y, z) and (yaw, pitch, roll).
+
+    The lens: focus_distance_m (metres) and aperture_mm (aperture diameter, 0 = a pinhole); None
+    leaves the field unset, the view's own lens. exposure_s: the shutter time that rain streaks
+    show (None: 1/60 s).
+    """
     spec = pb.ViewSpec(view=view_value(view), width=width, height=height,
                        jpeg_quality=quality, fov_deg=fov_deg)
     if camera_position_m is not None:
         spec.camera_position_m.CopyFrom(vec3(camera_position_m))
     if camera_rotation_deg is not None:
         spec.camera_rotation.CopyFrom(rotation(camera_rotation_deg))
+    if focus_distance_m is not None:
+        spec.focus_distance_m = focus_distance_m
+    if aperture_mm is not None:
+        spec.aperture_mm = aperture_mm
+    if exposure_s is not None:
+        spec.exposure_s = exposure_s
     return spec
 
 
@@ -73,5 +85,8 @@ def to_view_spec(value):
         return value
     if isinstance(value, dict):
         return view_spec(value["view"], value["width"], value["height"],
-                         value.get("jpeg_quality", 0), value.get("fov_deg", 0.0))
+                         value.get("jpeg_quality", 0), value.get("fov_deg", 0.0),
+                         focus_distance_m=value.get("focus_distance_m"),
+                         aperture_mm=value.get("aperture_mm"),
+                         exposure_s=value.get("exposure_s"))
     return view_spec(*value)

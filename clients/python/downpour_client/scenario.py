@@ -21,7 +21,11 @@ WEATHER_FIELDS = (
 )
 VEHICLE_FIELDS = ("position_m", "rotation_deg", "velocity_mps")
 WIPER_FIELDS = ("mode", "interval_s", "blade_angle_deg")
-VIEW_FIELDS = ("view", "width", "height", "jpeg_quality", "fov_deg")
+VIEW_FIELDS = ("view", "width", "height", "jpeg_quality", "fov_deg", "focus_distance_m",
+               "aperture_mm", "exposure_s")
+# The lens and shutter of a view, optional: left out, the proto field stays unset (the view's own).
+LENS_RANGES = {"focus_distance_m": (0.05, 10000.0), "aperture_mm": (0.0, 50.0),
+               "exposure_s": (0.0, 0.25)}
 TOP_FIELDS = ("name", "description", "duration_s", "loop", "seed", "fps", "views", "keyframes")
 MAX_VIEWS = 4
 
@@ -157,14 +161,18 @@ def _views(data):
         if number in seen:
             raise ValueError(f"{path}.view: {name} appears more than once")
         seen.add(number)
-        result.append({
+        spec = {
             "view": number,
             "width": _integer(view, "width", f"{path}.width", minimum=1, maximum=2**32 - 1),
             "height": _integer(view, "height", f"{path}.height", minimum=1, maximum=2**32 - 1),
             "jpeg_quality": _integer(view, "jpeg_quality", f"{path}.jpeg_quality", default=0,
                                      maximum=100),
             "fov_deg": _number(view, "fov_deg", f"{path}.fov_deg", default=0.0),
-        })
+        }
+        for field, (low, high) in LENS_RANGES.items():
+            if field in view:
+                spec[field] = _in_range(view[field], low, high, f"{path}.{field}")
+        result.append(spec)
     return result
 
 
@@ -217,6 +225,13 @@ def _finite(value, path):
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise ValueError(f"{path}: must be a finite number, got {value!r}")
     return float(value)
+
+
+def _in_range(value, low, high, path):
+    value = _finite(value, path)
+    if not low <= value <= high:
+        raise ValueError(f"{path}: must be in [{low:g}, {high:g}], got {value:g}")
+    return value
 
 
 def _number(obj, key, path, default=None, positive=False):

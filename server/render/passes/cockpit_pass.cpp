@@ -6,11 +6,21 @@ namespace downpour::render {
 
 CockpitPass::CockpitPass(SharedResources&)
     : program_("mesh.vert", "cockpit.frag"),
-      interior_(build_cockpit_interior(WindshieldCorners{})) {}
+      u_model_(program_.uniform("u_model")),
+      interior_(build_cockpit_interior(built_for_)) {}
 
-void CockpitPass::draw(const FrameContext& frame) {
+void CockpitPass::execute(const FrameContext& frame, const FrameResources&) {
+  // The cabin is built around the scene's glass (remade in the rare case that it changes).
+  const sim::GlassConfig& glass = frame.scene.glass;
+  if (glass.bottom_left_m != built_for_.bottom_left_m ||
+      glass.bottom_width_mm != built_for_.bottom_width_mm ||
+      glass.top_width_mm != built_for_.top_width_mm || glass.height_mm != built_for_.height_mm ||
+      glass.rake_deg != built_for_.rake_deg) {
+    built_for_ = glass;
+    interior_ = Mesh(build_cockpit_interior(built_for_));
+  }
   program_.use();
-  program_.set("u_model", frame.vehicle_to_world);
+  u_model_.set(frame.vehicle_to_world);
   interior_.draw();
 }
 

@@ -1,18 +1,25 @@
 #pragma once
 
-#include "server/render/frame_context.hpp"
+#include "server/render/pass.hpp"
 
 namespace downpour::render {
 
 // The cabin around the driver's eye: dashboard edge, A-pillars, roof liner and mirror, dark
-// silhouettes framing the view through the windshield.
-class CockpitPass {
+// silhouettes framing the view through the windshield, built around the glass of the scene.
+class CockpitPass final : public Pass {
  public:
   explicit CockpitPass(SharedResources& shared);
-  void draw(const FrameContext& frame);
+  const PassDecl& decl() const override { return decl_; }
+  void execute(const FrameContext& frame, const FrameResources& resources) override;
 
  private:
+  const PassDecl decl_{"cockpit",
+                       {},
+                       {Resource::kViewColour, Resource::kViewDepth},
+                       {DepthTest::kNearer, true, Blend::kOff}};
   ShaderProgram program_;
+  Uniform u_model_;
+  sim::GlassConfig built_for_;
   Mesh interior_;
 };
 

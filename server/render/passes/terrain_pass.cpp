@@ -4,17 +4,15 @@
 
 namespace downpour::render {
 
-TerrainPass::TerrainPass(SharedResources& shared) : program_("mesh.vert", "terrain.frag") {
-  for (const MeshData& chunk : build_terrain_chunks(shared.track)) chunks_.emplace_back(chunk);
-  program_.set("u_model", glm::mat4(1.0f));
+TerrainPass::TerrainPass(SharedResources& shared)
+    : program_("mesh.vert", "terrain.frag"),
+      chunks_(build_terrain_chunks(shared.track), {200.0f, 500.0f, 1200.0f}) {
+  program_.uniform("u_model").set(glm::mat4(1.0f));
 }
 
-void TerrainPass::draw(const FrameContext& frame) {
+void TerrainPass::execute(const FrameContext& frame, const FrameResources&) {
   program_.use();
-  const glm::mat4 view_proj = frame.camera.projection * frame.camera.view;
-  for (const Mesh& chunk : chunks_) {
-    if (box_visible(view_proj, chunk.bounds_min, chunk.bounds_max)) chunk.draw();
-  }
+  chunks_.draw_visible(frame.camera.projection * frame.camera.view, frame.camera.position);
 }
 
 }  // namespace downpour::render

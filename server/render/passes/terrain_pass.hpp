@@ -1,21 +1,25 @@
 #pragma once
 
-#include <vector>
-
-#include "server/render/frame_context.hpp"
+#include "server/render/chunked_mesh.hpp"
+#include "server/render/pass.hpp"
 
 namespace downpour::render {
 
 // The ground around the road: hills in chunks culled against the view, grass and soil shaded by
 // sun and sky, fogged with distance.
-class TerrainPass {
+class TerrainPass final : public Pass {
  public:
   explicit TerrainPass(SharedResources& shared);
-  void draw(const FrameContext& frame);
+  const PassDecl& decl() const override { return decl_; }
+  void execute(const FrameContext& frame, const FrameResources& resources) override;
 
  private:
+  const PassDecl decl_{"terrain",
+                       {},
+                       {Resource::kViewColour, Resource::kViewDepth},
+                       {DepthTest::kNearer, true, Blend::kOff}};
   ShaderProgram program_;
-  std::vector<Mesh> chunks_;
+  ChunkedMesh chunks_;
 };
 
 }  // namespace downpour::render

@@ -8,18 +8,24 @@
 namespace downpour::render {
 
 VehiclePass::VehiclePass(SharedResources&)
-    : program_("mesh.vert", "vehicle.frag"), hull_(build_car_hull()), upper_(build_car_upper()) {}
+    : program_("mesh.vert", "vehicle.frag"),
+      u_model_(program_.uniform("u_model")),
+      u_body_colour_(program_.uniform("u_body_colour")),
+      hull_(build_car_hull()),
+      upper_(build_car_upper()) {}
 
 void VehiclePass::draw_car(const glm::mat4& model, const glm::vec3& colour, bool hull_only) {
-  program_.set("u_model", model);
-  program_.set("u_body_colour", colour);
+  u_model_.set(model);
+  u_body_colour_.set(colour);
   hull_.draw();
   if (!hull_only) upper_.draw();
 }
 
-void VehiclePass::draw(const FrameContext& frame) {
+void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
   program_.use();
-  const bool cockpit = frame.spec.view == sim::View::kCockpit;
+  // From the driver's eye (COCKPIT, and RAIN, which sees from it) only the hood shows.
+  const bool cockpit =
+      frame.spec.view == sim::View::kCockpit || frame.spec.view == sim::View::kRain;
   draw_car(frame.vehicle_to_world, glm::vec3(0.42f, 0.05f, 0.04f), cockpit);
   const glm::mat4 view_proj = frame.camera.projection * frame.camera.view;
   static const glm::vec3 palette[] = {{0.75f, 0.75f, 0.78f}, {0.05f, 0.06f, 0.08f},

@@ -1,24 +1,27 @@
 #include "server/render/passes/windshield_pass.hpp"
 
-#include "server/render/wiper_blades.hpp"
+#include "server/render/glass_quad.hpp"
 
 namespace downpour::render {
 
 WindshieldPass::WindshieldPass(SharedResources& shared)
-    : shared_(shared), program_("fullscreen.vert", "windshield.frag") {}
+    : shared_(shared),
+      program_("fullscreen.vert", "windshield.frag"),
+      blades_(program_),
+      u_aspect_(program_.uniform("u_aspect")),
+      u_glass_mm_(program_.uniform("u_glass_mm")),
+      u_map_size_mm_(program_.uniform("u_map_size_mm")) {
+  program_.uniform("u_threshold").set(sim::HeightCompressionConfig{}.threshold);
+}
 
-void WindshieldPass::draw(const FrameContext& frame, const WindshieldWaterPass& water) {
+void WindshieldPass::execute(const FrameContext& frame, const FrameResources&) {
   const sim::GlassConfig& glass = frame.scene.glass;
-  glDisable(GL_DEPTH_TEST);
+  const sim::WindshieldState& water = frame.water();
   program_.use();
-  program_.set("u_aspect",
-               static_cast<float>(frame.spec.width) / static_cast<float>(frame.spec.height));
-  program_.set("u_glass_mm", glm::vec3(glass.bottom_width_mm, glass.top_width_mm, glass.height_mm));
-  program_.set("u_map_origin_mm", water.layout().origin_mm);
-  program_.set("u_map_extent_mm", water.layout().extent_mm);
-  program_.set("u_threshold", water.config().compression.threshold);
-  set_wiper_blade_uniforms(program_, frame.scene.windshield.blades);
-  glBindTextureUnit(binding::kWaterMap, water.water_map());
+  u_aspect_.set(static_cast<float>(frame.spec.width) / static_cast<float>(frame.spec.height));
+  u_glass_mm_.set(glm::vec3(glass.bottom_width_mm, glass.top_width_mm, glass.height_mm));
+  u_map_size_mm_.set(map_size_mm(water.map, glass));
+  blades_.set(water.blades);
   shared_.fullscreen.draw();
 }
 

@@ -1,22 +1,25 @@
 #pragma once
 
-#include "server/render/frame_context.hpp"
-#include "server/render/passes/windshield_water_pass.hpp"
+#include "server/render/pass.hpp"
+#include "server/render/wiper_blades.hpp"
 
 namespace downpour::render {
 
 // The WINDSHIELD view: the glass alone in glass space (u across, v up the glass) fitted to the
 // view, as ground truth for perception tests. Dry glass is black, water grey by its compressed
 // height (brighter where it is thicker), the glass's outline faint grey, the wiper blades blue.
-// Reads: the water map of WindshieldWaterPass (made for this view), the blade poses.
-class WindshieldPass {
+class WindshieldPass final : public Pass {
  public:
   explicit WindshieldPass(SharedResources& shared);
-  void draw(const FrameContext& frame, const WindshieldWaterPass& water);
+  const PassDecl& decl() const override { return decl_; }
+  void execute(const FrameContext& frame, const FrameResources& resources) override;
 
  private:
+  const PassDecl decl_{"windshield", {Resource::kGlassWater}, {Resource::kViewColour}, {}, true};
   SharedResources& shared_;
   ShaderProgram program_;
+  WiperBladeUniforms blades_;
+  Uniform u_aspect_, u_glass_mm_, u_map_size_mm_;
 };
 
 }  // namespace downpour::render

@@ -2,9 +2,12 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include <gtest/gtest.h>
+
+#include "server/rpc/convert.hpp"
 
 namespace downpour::rpc {
 namespace {
@@ -207,6 +210,96 @@ TEST(ValidationTest, CameraPoseIsForTheRoadAndCockpitViewsOnly) {
   EXPECT_TRUE(create(dash).ok());
 }
 
+TEST(ValidationTest, LensSettingsReachTheDomainViewSpec) {
+  v1::CreateSessionRequest r;
+  v1::ViewSpec dash = view(v1::VIEW_COCKPIT);
+  dash.mutable_camera_position_m()->set_x(1.9);
+  dash.set_focus_distance_m(0.6);
+  dash.set_aperture_mm(0.0);  // a pinhole
+  *r.add_views() = dash;
+  v1::ViewSpec road = view(v1::VIEW_ROAD);  // no glass in sight: accepted all the same
+  road.set_focus_distance_m(10000.0);
+  road.set_aperture_mm(50.0);
+  *r.add_views() = road;
+  v1::ViewSpec windshield = view(v1::VIEW_WINDSHIELD);
+  windshield.set_focus_distance_m(0.05);  // the aperture left out
+  *r.add_views() = windshield;
+  v1::ViewSpec rain = view(v1::VIEW_RAIN);  // no lens; a shutter of its own
+  rain.set_exposure_s(0.0);
+  *r.add_views() = rain;
+
+  session::SessionConfig config;
+  sim::Update initial;
+  const grpc::Status status = to_session_config(r, Limits{}, &config, &initial);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(config.views.size(), 4u);
+  EXPECT_EQ(config.views[0].focus_distance_m, 0.6);
+  EXPECT_EQ(config.views[0].aperture_mm, 0.0);
+  EXPECT_EQ(config.views[1].focus_distance_m, 10000.0);
+  EXPECT_EQ(config.views[1].aperture_mm, 50.0);
+  EXPECT_EQ(config.views[2].focus_distance_m, 0.05);
+  EXPECT_EQ(config.views[2].aperture_mm, std::nullopt);
+  EXPECT_EQ(config.views[3].focus_distance_m, std::nullopt);
+  EXPECT_EQ(config.views[3].aperture_mm, std::nullopt);
+  EXPECT_EQ(config.views[3].exposure_s, 0.0);
+  EXPECT_EQ(config.views[0].exposure_s, std::nullopt);
+}
+
+TEST(ValidationTest, LensSettingsOutOfRange) {
+  for (double bad : {0.0, 0.04, -1.0, 10001.0, kNaN, kInf, -kInf}) {
+    v1::CreateSessionRequest r = good_request();
+    *r.add_views() = view(v1::VIEW_ROAD);
+    r.mutable_views(1)->set_focus_distance_m(bad);
+    EXPECT_TRUE(invalid_naming(create(r), "views[1].focus_distance_m")) << bad;
+  }
+  for (double bad : {-0.5, 50.5, 80.0, kNaN, kInf, -kInf}) {
+    v1::CreateSessionRequest r = good_request();
+    *r.add_views() = view(v1::VIEW_ROAD);
+    r.mutable_views(1)->set_aperture_mm(bad);
+    EXPECT_TRUE(invalid_naming(create(r), "views[1].aperture_mm")) << bad;
+  }
+  for (double bad : {-0.001, 0.26, 1.0, kNaN, kInf}) {
+    v1::CreateSessionRequest r = good_request();
+    *r.add_views() = view(v1::VIEW_ROAD);
+    r.mutable_views(1)->set_exposure_s(bad);
+    EXPECT_TRUE(invalid_naming(create(r), "views[1].exposure_s")) << bad;
+  }
+  v1::CreateSessionRequest r = good_request();
+  *r.add_views() = view(v1::VIEW_ROAD);
+  r.mutable_views(1)->set_aperture_mm(80.0);
+  EXPECT_EQ(create(r).error_message(), "views[1].aperture_mm: must be in [0, 50], got 80");
+  r.mutable_views(1)->set_aperture_mm(4.0);
+  r.mutable_views(1)->set_focus_distance_m(kNaN);
+  EXPECT_EQ(create(r).error_message(),
+            "views[1].focus_distance_m: must be a finite number, got nan");
+}
+
+TEST(ValidationTest, SessionInfoEchoesTheLensWhenSet) {
+  v1::CreateSessionRequest r;
+  *r.add_views() = view(v1::VIEW_COCKPIT);
+  r.mutable_views(0)->set_focus_distance_m(1.5);
+  r.mutable_views(0)->set_aperture_mm(0.0);
+  *r.add_views() = view(v1::VIEW_WINDSHIELD);
+  r.mutable_views(1)->set_aperture_mm(2.5);
+  *r.add_views() = view(v1::VIEW_RAIN);
+  session::SessionConfig config;
+  sim::Update initial;
+  ASSERT_TRUE(to_session_config(r, Limits{}, &config, &initial).ok());
+  const session::Session session("s1", 1, config, initial, [] {});
+  v1::SessionInfo info;
+  fill_session_info(session, &info);
+  ASSERT_EQ(info.views_size(), 3);
+  ASSERT_TRUE(info.views(0).has_focus_distance_m());
+  EXPECT_EQ(info.views(0).focus_distance_m(), 1.5);
+  ASSERT_TRUE(info.views(0).has_aperture_mm());  // 0 (a pinhole) is set, not absent
+  EXPECT_EQ(info.views(0).aperture_mm(), 0.0);
+  EXPECT_FALSE(info.views(1).has_focus_distance_m());
+  ASSERT_TRUE(info.views(1).has_aperture_mm());
+  EXPECT_EQ(info.views(1).aperture_mm(), 2.5);
+  EXPECT_FALSE(info.views(2).has_focus_distance_m());
+  EXPECT_FALSE(info.views(2).has_aperture_mm());
+}
+
 TEST(ValidationTest, SessionId) {
   EXPECT_TRUE(invalid_naming(check_session_id("", "session_id"), "session_id"));
   EXPECT_TRUE(invalid_naming(check_session_id(std::string(65, 'a'), "session_id"), "session_id"));
@@ -229,6 +322,8 @@ TEST(ValidationTest, DefaultsAreFilledIn) {
   EXPECT_EQ(config.views[0].jpeg_quality, 85);  // jpeg_quality 0
   EXPECT_EQ(config.views[0].fov_deg, 0.0);
   EXPECT_FALSE(config.views[0].camera);
+  EXPECT_FALSE(config.views[0].focus_distance_m);  // absent: the view's own lens
+  EXPECT_FALSE(config.views[0].aperture_mm);
   // An empty initial update carries no channels.
   EXPECT_FALSE(initial.vehicle);
   EXPECT_FALSE(initial.wipers);

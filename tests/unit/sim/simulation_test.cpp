@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "server/sim/scenario.hpp"
+
 namespace downpour::sim {
 namespace {
 
@@ -71,8 +73,24 @@ TEST(SimulationTest, UnevenStepsMatchOneBigStep) {
   EXPECT_EQ(a.state().sub_steps, static_cast<std::uint64_t>(std::floor(total * 240.0)));
 }
 
+TEST(SimulationTest, InputsAfterAStepAreItsStateButTheWater) {
+  const Scenario scenario = highway_heavy_rain();
+  Simulation sim(scenario.seed, scenario.at(3.0));
+  for (const double dt : {1.0 / 30.0, 1.0 / 60.0, 0.0101, 0.25, 1.0 / 240.0}) {
+    const SceneState before = sim.inputs_after(dt);
+    sim.advance(dt);
+    EXPECT_EQ(before.sim_time_s, sim.state().sim_time_s) << "dt " << dt;
+    EXPECT_EQ(before.sub_steps, sim.state().sub_steps);
+    EXPECT_EQ(before.vehicle.position_m, sim.state().vehicle.position_m);
+    EXPECT_EQ(before.weather.rain_rate_mm_h, sim.state().weather.rain_rate_mm_h);
+    EXPECT_TRUE(before.windshield.metaballs.empty());
+  }
+}
+
 TEST(SimulationTest, ConfiguredSubStep) {
-  Simulation sim(1, {}, SimulationConfig{0.01});
+  SimulationConfig config;
+  config.sub_step_s = 0.01;
+  Simulation sim(1, {}, config);
   sim.advance(0.1);
   EXPECT_EQ(sim.state().sub_steps, 10u);
   EXPECT_NEAR(sim.state().sim_time_s, 0.1, 1e-12);

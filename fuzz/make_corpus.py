@@ -1,0 +1,94 @@
+#!/usr/bin/python3
+"""Writes the fuzzers' seed corpus (fuzz/corpus/<target>/) from requests a real client sends and
+a few scenario files. Run with Debian's python3 and the generated stubs:
+  PYTHONPATH=build/python /usr/bin/python3 fuzz/make_corpus.py
+"""
+import hashlib
+import os
+import shutil
+import sys
+
+from downpour.v1 import downpour_pb2 as pb
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+CORPUS = os.path.join(ROOT, "fuzz", "corpus")
+
+
+def write(target, data):
+    folder = os.path.join(CORPUS, target)
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, hashlib.sha1(data).hexdigest()[:16]), "wb") as f:
+        f.write(data)
+
+
+def rain_update(t, rain=12.0):
+    u = pb.Update(sim_time_s=t)
+    u.vehicle.position_m.x = 20.0 * t
+    u.vehicle.position_m.y = -5.25
+    u.vehicle.velocity_mps.x = 20.0
+    u.vehicle.rotation.yaw_deg = 3.0
+    u.weather.rain_rate_mm_h = rain
+    u.weather.wind_speed_mps = 4.0
+    u.weather.cloudiness = 0.8
+    u.wipers.mode = pb.WIPER_LOW
+    u.replace_traffic = True
+    car = u.traffic.add()
+    car.id = 7
+    car.state.position_m.x = 20.0 * t + 30.0
+    car.state.velocity_mps.x = 18.0
+    return u
+
+
+def requests():
+    create = pb.CreateSessionRequest(mode=pb.MODE_LOCKSTEP, seed=42, fps=30.0)
+    create.views.add(view=pb.VIEW_COCKPIT, width=640, height=360, jpeg_quality=85)
+    road = create.views.add(view=pb.VIEW_ROAD, width=320, height=180, jpeg_quality=70, fov_deg=60.0)
+    road.camera_position_m.z = 1.5
+    road.camera_rotation.pitch_deg = -5.0
+    create.views.add(view=pb.VIEW_WINDSHIELD, width=256, height=256, focus_distance_m=3.0,
+                     aperture_mm=2.0)
+    create.initial.CopyFrom(rain_update(0.0))
+    yield 0, create
+    yield 0, pb.CreateSessionRequest(mode=pb.MODE_REALTIME, fps=30.0,
+                                     views=[pb.ViewSpec(view=pb.VIEW_RAIN, width=16, height=16)])
+    yield 1, pb.UpdateRequest(session_id="s1-" + "0" * 32, update=rain_update(1.0))
+    yield 2, pb.StepRequest(session_id="s2-" + "ab" * 16, update=rain_update(0.5), dt_s=1 / 30)
+    yield 3, pb.DriveRequest(session_id="s3-" + "f" * 32, update=rain_update(0.1), dt_s=0.1)
+    yield 3, pb.DriveRequest(update=pb.Update(weather=pb.Weather(rain_rate_mm_h=50.0)))
+    yield 4, pb.ViewSpec(view=pb.VIEW_ROAD, width=1280, height=720, jpeg_quality=90)
+
+
+def random_length_string(data):
+    # The framing of FuzzedDataProvider::ConsumeRandomLengthString: a backslash is doubled, and
+    # a backslash followed by another byte ends the string.
+    return data.replace(b"\\", b"\\\\") + b"\\n"
+
+
+def main():
+    for target in ("request", "scenario", "simulation"):
+        shutil.rmtree(os.path.join(CORPUS, target), ignore_errors=True)
+    for kind, message in requests():
+        write("request", bytes([kind]) + message.SerializeToString())
+    # (the fuzz run adds the standard scenes, clients/scenarios/, to these)
+    write("scenario", b'{"name": "x", "duration_s": 2, "keyframes": [{"t": 0, "weather": '
+                      b'{"rain_rate_mm_h": 10}}, {"t": 2, "vehicle": {"position_m": [40, 0, 0]}}]}')
+    write("scenario", b'{"name": "x", "keyframes": [{"t": 1.0}, {"t": 0.5}]}')
+    write("scenario", b'{"name": "x", "fps": 0, "keyframes": []}')
+    # Simulation: a seed byte, then framed DriveRequests: rain, wipers on, a gust, a stop.
+    feed = [pb.DriveRequest(update=rain_update(0.1 * i, rain=5.0 + 10 * i), dt_s=0.1)
+            for i in range(6)]
+    feed.append(pb.DriveRequest(update=pb.Update(wipers=pb.WiperState(mode=pb.WIPER_HIGH)), dt_s=0.2))
+    feed.append(pb.DriveRequest(update=pb.Update(weather=pb.Weather(rain_rate_mm_h=100.0,
+                                                                   wind_speed_mps=25.0)),
+                                dt_s=0.25))
+    stop = rain_update(1.0)
+    stop.vehicle.velocity_mps.x = 0.0
+    feed.append(pb.DriveRequest(update=stop, dt_s=0.25))
+    data = bytes([3]) + b"".join(random_length_string(r.SerializeToString()) for r in feed)
+    write("simulation", data)
+    write("simulation", bytes([0]) + random_length_string(feed[0].SerializeToString()))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,103 @@
+// Fuzz target: the simulation under a feed a client could send. The input is a sequence of
+// (length, DriveRequest bytes) records; each request the service would accept is applied and the
+// simulation advanced by its dt_s (capped at 0.2 s per input, and on a coarse water map, so that
+// one input stays quick: the same code at a quarter of the resolution). After every step the state
+// must be finite and the water must be accounted for: what arrived on the glass is on it, wiped
+// off, drained or evaporated; the rain in the air stays bounded and finite.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+#include <fuzzer/FuzzedDataProvider.h>
+
+#include "downpour/v1/downpour.pb.h"
+#include "server/rpc/validation.hpp"
+#include "server/sim/simulation.hpp"
+
+namespace {
+
+using namespace downpour;
+
+void require(bool ok) {
+  if (!ok) std::abort();
+}
+
+void check(const sim::Simulation& simulation) {
+  const sim::SceneState& s = simulation.state();
+  require(std::isfinite(s.sim_time_s));
+  require(std::isfinite(s.vehicle.position_m.x) && std::isfinite(s.vehicle.position_m.y));
+  const sim::WaterSim& water = simulation.water();
+  const sim::WaterLedger l = water.ledger();
+  const double on_glass = water.mass_on_glass();
+  require(std::isfinite(on_glass) && on_glass >= 0.0);
+  const double accounted = on_glass + l.wiped_off + l.drained + l.evaporated;
+  require(std::abs(accounted - l.arrived) <= 1e-6 * std::max(1.0, l.arrived));
+  // The rain in the air: bounded, finite, of the sizes the field draws.
+  const sim::RainField& rain = simulation.rain();
+  require(rain.drops().size() <= sim::kMaxRainDrops);
+  for (const sim::RainDrop& d : rain.drops()) {
+    require(std::isfinite(d.position_m.x) && std::isfinite(d.position_m.y) &&
+            std::isfinite(d.position_m.z));
+    require(d.diameter_mm >= rain.config().min_diameter_mm &&
+            d.diameter_mm <= rain.config().max_diameter_mm);
+  }
+  // Its splashes as published: bounded, finite, young.
+  const sim::RainState& published = simulation.state().rain;
+  require(published.splashes.size() <= sim::kMaxRainSplashes);
+  for (const sim::SplashState& s : published.splashes) {
+    require(std::isfinite(s.position.x) && std::isfinite(s.position.y) &&
+            std::isfinite(s.position.z));
+    require(s.age_s >= 0.0f && s.age_s <= sim::kSplashLifeS + 1e-6);
+    require(s.diameter_mm >= rain.config().min_diameter_mm - 1e-6 &&
+            s.diameter_mm <= rain.config().max_diameter_mm + 1e-6);
+  }
+  for (const auto& d : water.drops()) {
+    if (!d.alive) continue;
+    require(std::isfinite(d.pos.x) && std::isfinite(d.pos.y) && std::isfinite(d.mass));
+    require(d.mass > 0.0);
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  FuzzedDataProvider in(data, size);
+  const rpc::Limits limits;
+  const std::uint8_t seed = in.ConsumeIntegral<std::uint8_t>();
+  // A fresh simulation for each seed is built once and copied for each input: the copy is the
+  // same state as a new one, at a small part of the cost (the glass mesh and the first map).
+  static std::array<std::unique_ptr<sim::Simulation>, 256> fresh;
+  if (!fresh[seed]) {
+    sim::Update initial;
+    initial.weather = sim::Weather{};
+    initial.weather->rain_rate_mm_h = 20.0;
+    sim::SimulationConfig config;
+    config.water_map.texel_mm = 8.0;
+    // A smaller rain box (the same code, a twentieth of the drops), like the coarse map.
+    config.rain.length_m = 6.0;
+    config.rain.width_m = 4.0;
+    config.rain.height_m = 3.0;
+    fresh[seed] = std::make_unique<sim::Simulation>(seed, initial, config);
+  }
+  sim::Simulation simulation = *fresh[seed];
+  double budget_s = 0.2;  // simulated time per input: 48 sub-steps, a wiper stroke's start
+  while (in.remaining_bytes() > 0 && budget_s > 0.0) {
+    const std::string bytes = in.ConsumeRandomLengthString(512);
+    v1::DriveRequest req;
+    if (!req.ParseFromString(bytes)) continue;
+    sim::Update update;
+    if (!rpc::to_update(req.update(), "update", limits, &update).ok()) continue;
+    if (!rpc::check_dt(req.dt_s(), "dt_s", true, limits).ok()) continue;
+    simulation.apply(update);
+    const double dt = std::min(req.dt_s(), std::min(0.1, budget_s));
+    budget_s -= std::max(dt, 0.01);
+    if (dt > 0.0) simulation.advance(dt);
+    check(simulation);
+  }
+  return 0;
+}

@@ -1,0 +1,46 @@
+#include "server/render/glass_quad.hpp"
+
+#include <algorithm>
+
+namespace downpour::render {
+
+GlassPlacement::GlassPlacement(const ShaderProgram& program)
+    : origin_(program.uniform("u_glass_origin")),
+      u_(program.uniform("u_glass_u")),
+      v_(program.uniform("u_glass_v")),
+      size_mm_(program.uniform("u_glass_mm")) {}
+
+void GlassPlacement::set(const FrameContext& frame) const {
+  const sim::GlassConfig& glass = frame.scene.glass;
+  const glm::mat3 rotation(frame.vehicle_to_world);
+  origin_.set(glm::vec3(frame.vehicle_to_world * glm::vec4(glm::vec3(glass.bottom_left_m), 1.0f)));
+  u_.set(rotation * glm::vec3(glass.u_axis()));
+  v_.set(rotation * glm::vec3(glass.v_axis()));
+  size_mm_.set(glm::vec3(glass.bottom_width_mm, glass.top_width_mm, glass.height_mm));
+}
+
+GlassQuad::GlassQuad(const ShaderProgram& program) : placement_(program) {
+  GLuint vao = 0;
+  glCreateVertexArrays(1, &vao);
+  empty_vao_ = VertexArray(vao);
+}
+
+void GlassQuad::draw(const FrameContext& frame) const {
+  placement_.set(frame);
+  glBindVertexArray(empty_vao_.id());
+  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+}
+
+glm::vec2 map_size_mm(const sim::GlassWaterMap& map, const sim::GlassConfig& glass) {
+  if (map.width <= 0 || map.height <= 0) return glm::vec2(glass.bottom_width_mm, glass.height_mm);
+  return glm::vec2(map.width, map.height) * static_cast<float>(map.texel_mm);
+}
+
+bool glass_has_water_or_blades(const sim::WindshieldState& water) {
+  const bool any_blade =
+      std::any_of(water.blades.begin(), water.blades.end(),
+                  [](const sim::BladePose& b) { return b.length_mm > 0.0f && b.width_mm > 0.0f; });
+  return any_blade || water.map.wet_fraction > 0.0 || !water.metaballs.empty();
+}
+
+}  // namespace downpour::render

@@ -1,0 +1,49 @@
+// A render pass declared in one place: its name, what it reads and writes (by Resource), its GL
+// state and its draw code. A view is a list of passes (data, in renderer.cpp); the renderer binds
+// each pass's target and inputs, applies its state, and checks at start-up that every pass reads
+// only what the frame provides or an earlier pass of the view wrote.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "server/render/frame_context.hpp"
+#include "server/render/render_state.hpp"
+
+namespace downpour::render {
+
+enum class Resource : std::uint8_t {
+  kViewColour,  // the view's colour target: cleared at the frame's start
+  kViewDepth,   // its depth (reversed-Z): cleared at the frame's start
+  kSceneBlur,   // the scene outside the glass, an eighth of the view
+  kGlassLayer,  // the water on the glass over the scene, reduced size, premultiplied
+  kGlassWater,  // the session's glass water map, uploaded from the simulation on first read
+};
+inline constexpr std::size_t kResourceCount = 5;
+std::string_view resource_name(Resource resource);
+
+struct PassDecl {
+  std::string name;
+  std::vector<Resource> reads;   // bound to their texture units before the pass runs
+  std::vector<Resource> writes;  // one target: the view (colour and/or depth), or a transient
+  RenderState state;
+  bool reads_step = false;  // calls FrameContext::water() or rain(): the state after the step
+};
+
+class Pass {
+ public:
+  virtual ~Pass() = default;
+  virtual const PassDecl& decl() const = 0;
+  // Nothing to draw this frame (clear glass) skips the pass and its target's preparation.
+  virtual bool wanted(const FrameContext&) const { return true; }
+  virtual void execute(const FrameContext& frame, const FrameResources& resources) = 0;
+};
+
+// Throws std::logic_error naming the pass and the resource where a pass of `view` reads what
+// neither the frame's start nor an earlier pass provides, or writes more than one target.
+void check_pass_order(std::string_view view, const std::vector<Pass*>& passes);
+
+}  // namespace downpour::render

@@ -1,0 +1,535 @@
+#include "server/render/rain_layer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <utility>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+
+namespace downpour::render {
+
+namespace {
+
+// The scene's display transform (common.glsl's to_display): a gentle shoulder, then gamma 2.
+glm::vec3 to_display(glm::vec3 c) {
+  c = glm::clamp(c / (1.0f + 0.15f * c), 0.0f, 1.0f);
+  return glm::vec3(std::sqrt(c.x), std::sqrt(c.y), std::sqrt(c.z));
+}
+
+// Terminal speed by diameter, over the field's sizes (0-8 mm).
+struct SpeedTable {
+  static constexpr int kSteps = 256;
+  static constexpr float kStepMm = 8.0f / kSteps;
+  float speed[kSteps + 1];
+  float at(float diameter_mm) const {
+    return speed[std::clamp(static_cast<int>(diameter_mm / kStepMm + 0.5f), 0, kSteps)];
+  }
+};
+const SpeedTable& speed_table() {
+  static const SpeedTable table = [] {
+    SpeedTable t;
+    for (int i = 0; i <= SpeedTable::kSteps; ++i)
+      t.speed[i] = static_cast<float>(sim::terminal_speed_mps(i * SpeedTable::kStepMm));
+    return t;
+  }();
+  return table;
+}
+
+// A texel's coverage in bytes for its summed opacities: independent coverings, 1 - exp(-sum).
+struct CoverageTable {
+  static constexpr int kSteps = 512;
+  static constexpr float kMax = 8.0f;
+  std::uint32_t coverage[kSteps + 1];
+  std::uint32_t at(float alpha) const {
+    return coverage[std::min(static_cast<int>(alpha * (kSteps / kMax) + 0.5f), kSteps)];
+  }
+};
+const CoverageTable& coverage_table() {
+  static const CoverageTable table = [] {
+    CoverageTable t;
+    for (int i = 0; i <= CoverageTable::kSteps; ++i) {
+      const float a = 1.0f - std::exp(-CoverageTable::kMax * i / CoverageTable::kSteps);
+      t.coverage[i] = static_cast<std::uint32_t>(a * 255.0f + 0.5f);
+    }
+    return t;
+  }();
+  return table;
+}
+
+}  // namespace
+
+struct RainLayer::Batch {
+  float x[kBatch], y[kBatch], z[kBatch], diameter[kBatch], speed[kBatch];
+  float far_fade[kBatch], top_fade[kBatch];
+  float head_x[kBatch], head_y[kBatch], head_z[kBatch];
+  float motion_x[kBatch], motion_y[kBatch], motion_z[kBatch], reach[kBatch];
+  // Per copy and drop: the streak on the layer, or alpha 0 where none is drawn.
+  float hx[kMaxCopies][kBatch], hy[kMaxCopies][kBatch], tx[kMaxCopies][kBatch],
+      ty[kMaxCopies][kBatch], depth[kMaxCopies][kBatch], alpha[kMaxCopies][kBatch],
+      width[kMaxCopies][kBatch];
+};
+
+RainLayer::RainLayer() : batches_{std::make_unique<Batch>(), std::make_unique<Batch>()} {}
+RainLayer::~RainLayer() = default;
+
+std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs& in, int width,
+                               int height) {
+  const std::size_t texels = static_cast<std::size_t>(std::max(width, 0)) * std::max(height, 0);
+  if (width != width_ || height != height_) {
+    width_ = width;
+    height_ = height;
+    texels_.assign(texels, Texel{});
+    occluder_depth_.assign(texels, kUntouched);
+    occluded_ = Bounds{};
+    second_.assign(texels, Texel{});
+    depth_.assign(texels, 0.0f);
+    colour_.assign(texels, 0u);
+  } else {
+    // The texels were left clear by the last resolve; the outputs are cleared where it wrote.
+    for (int y = bounds_.y0; y < bounds_.y1; ++y) {
+      const std::size_t row = static_cast<std::size_t>(y) * width + bounds_.x0;
+      std::fill_n(depth_.begin() + row, bounds_.x1 - bounds_.x0, 0.0f);
+      std::fill_n(colour_.begin() + row, bounds_.x1 - bounds_.x0, 0u);
+    }
+  }
+  bounds_ = Bounds{};
+  if (rain.drops.empty() || width <= 0 || height <= 0) return 0;
+
+  const glm::vec3 fall = rain.fall_direction;
+  const glm::vec3 wind = rain.wind_mps;
+  const glm::vec3 camera_velocity(in.camera_velocity);
+  const float dt = static_cast<float>(in.dt_s), exposure = static_cast<float>(in.exposure_s);
+  // Drops are relative to the field's origin; so is the camera here, so that floats keep
+  // millimetres wherever the car is.
+  const glm::dvec3 origin = rain.origin_m;
+  glm::dmat4 to_origin(1.0);
+  to_origin[3] = glm::dvec4(origin, 1.0);
+  const glm::mat4 view(glm::dmat4(in.view) * to_origin);
+  const glm::mat3 rotate(view);
+  // In the camera's frame: the fall's direction, and the drift of every drop relative to the camera
+  // (wind less the camera's velocity); a drop's velocity is fall x its speed + wind.
+  const glm::vec3 fall_v = rotate * fall;
+  const glm::vec3 wind_v = rotate * wind;
+  const glm::vec3 relative_drift_v = rotate * (wind - camera_velocity);
+  const float tan_x = static_cast<float>(in.tan_half_fov_x);
+  const float tan_y = static_cast<float>(in.tan_half_fov_y);
+  const float sx = 0.5f * width / static_cast<float>(in.tan_half_fov_x);
+  const float sy = 0.5f * height / static_cast<float>(in.tan_half_fov_y);
+  const float cx = 0.5f * width, cy = 0.5f * height;
+  const int max_steps = 2 * (width + height);
+  // Tables instead of an exp per drop: terminal speed by diameter (the field's sizes, 0-8 mm;
+  // made once) and the haze's transmittance by distance (0-64 m; this view's haze).
+  const SpeedTable& speeds = speed_table();
+  constexpr int kHazeSteps = 256;
+  constexpr float kHazeStepM = 64.0f / kHazeSteps;
+  float transmittance[kHazeSteps + 1];
+  for (int i = 0; i <= kHazeSteps; ++i)
+    transmittance[i] = std::exp(-in.haze_per_m * i * kHazeStepM);
+
+  // The box repeats across and along: its drops are drawn again one box width to each side, so
+  // that the rain fills the view to its edges where the view is wider than the box (far ahead) and
+  // the box's sides leave no seam; and, for a camera behind the box (the chase camera), one box
+  // length back as well, so that there is rain between that camera and the car. The drops wrap at
+  // the box's sides and ends already, so the copies continue the same field. (Upwards the view's
+  // top is the sky, far off, where the haze hides what streaks there would be; the box's top
+  // fades out instead.)
+  struct Copy {
+    glm::vec3 offset_v;
+    bool behind;  // continues the box's near end: its far-end fade does not apply
+  };
+  const glm::vec3 across = rotate * (rain.box_left * (2.0f * rain.box_half_m.y));
+  const glm::vec3 back = rotate * (rain.box_forward * (-2.0f * rain.box_half_m.x));
+  Copy copies[kMaxCopies] = {{glm::vec3(0.0f), false}, {across, false}, {-across, false}};
+  int copy_count = 3;
+  const glm::dvec3 camera = glm::dvec3(glm::inverse(in.view)[3]) - origin;
+  if (glm::dot(glm::vec3(camera), rain.box_forward) < -rain.box_half_m.x + kNearestM) {
+    copies[copy_count++] = {back, true};
+    copies[copy_count++] = {back + across, true};
+    copies[copy_count++] = {back - across, true};
+  }
+  // Each thread works through its drops in batches, in two phases: first every copy of every drop
+  // of the batch as branch-free arithmetic over arrays, which the compiler turns into vector code
+  // (the projection, the cull and the opacity); then the streaks that came out visible, one by one,
+  // as Wu lines.
+  const float px = in.pixels_per_texel;
+  const float opacity = in.opacity;
+  auto project = [&](Batch& b, int n) {
+    for (int i = 0; i < n; ++i) {
+      const glm::vec3 rel(b.x[i], b.y[i], b.z[i]);
+      const glm::vec3 head =
+          glm::vec3(view * glm::vec4(rel, 1.0f)) + (fall_v * b.speed[i] + wind_v) * dt;
+      b.head_x[i] = head.x, b.head_y[i] = head.y, b.head_z[i] = head.z;
+      // The streak: from the head back along the drop's motion relative to the camera.
+      const glm::vec3 motion = (fall_v * b.speed[i] + relative_drift_v) * exposure;
+      b.motion_x[i] = motion.x, b.motion_y[i] = motion.y, b.motion_z[i] = motion.z;
+      b.reach[i] = std::abs(motion.x) + std::abs(motion.y) + std::abs(motion.z);
+      // The box's far end and top fade out; its sides are seamless (the copies).
+      b.far_fade[i] = std::clamp(
+          (rain.box_half_m.x - glm::dot(rel, rain.box_forward)) * (1.0f / 8.0f), 0.0f, 1.0f);
+      b.top_fade[i] = std::clamp((rain.box_half_m.z - rel.z) * (1.0f / 1.5f), 0.0f, 1.0f);
+    }
+    for (int c = 0; c < copy_count; ++c) {
+      const glm::vec3 offset = copies[c].offset_v;
+      const float behind = copies[c].behind ? 1.0f : 0.0f;
+      for (int i = 0; i < n; ++i) {
+        const float hvx = b.head_x[i] + offset.x, hvy = b.head_y[i] + offset.y;
+        const float depth = -(b.head_z[i] + offset.z);
+        const float reach = b.reach[i];
+        // Drops nearer than kNearestM are not drawn (any eye or camera focused on the road sees
+        // them as a faint blur). Most copies lie wholly outside the view: a streak whose head is
+        // further out of the view than the streak reaches cannot come into it.
+        // (& and |, not && and ||: no branches, so that the loop is vector code.)
+        bool visible = (depth >= kNearestM) & (std::abs(hvx) - reach <= tan_x * (depth + reach)) &
+                       (std::abs(hvy) - reach <= tan_y * (depth + reach));
+        float tvx = hvx - b.motion_x[i], tvy = hvy - b.motion_y[i];
+        float tail_depth = depth + b.motion_z[i];
+        // A tail behind the camera: cut where the streak comes within 6 cm of it.
+        const bool cut = tail_depth < 0.06f;
+        const float t = cut ? (depth - 0.06f) / std::max(depth - tail_depth, 1e-6f) : 1.0f;
+        tvx = hvx + (tvx - hvx) * t;
+        tvy = hvy + (tvy - hvy) * t;
+        tail_depth = cut ? 0.06f : tail_depth;
+        const float inv_depth = 1.0f / std::max(depth, kNearestM);
+        const float inv_tail = 1.0f / std::max(tail_depth, 0.06f);
+        const float hx = cx + sx * hvx * inv_depth, hy = cy + sy * hvy * inv_depth;
+        const float tx = cx + sx * tvx * inv_tail, ty = cy + sy * tvy * inv_tail;
+        visible = visible & !(((hx < 0.0f) & (tx < 0.0f)) | ((hy < 0.0f) & (ty < 0.0f)) |
+                              ((hx >= width) & (tx >= width)) | ((hy >= height) & (ty >= height)));
+        // Widths and lengths in the view's pixels, for the same opacity at any layer size.
+        const float true_width = b.diameter[i] * 1e-3f * sy * inv_depth * px;
+        const float half_width = 0.5f * std::max(true_width, 1.0f) + 0.5f;
+        const float core = std::clamp(true_width / (2.0f * half_width), 0.0f, 1.0f);
+        const float length = std::max(std::abs(tx - hx), std::abs(ty - hy));
+        const float spread =
+            std::clamp(2.0f * half_width / std::max(length * px, 1.0f), 0.3f, 1.0f);
+        // Haze (seed 004): far streaks fade in steps of opacity, 3/4, 1/2 and 1/4, by distance.
+        const float level = depth < 5.0f    ? 1.0f
+                            : depth < 10.0f ? 0.75f
+                            : depth < 16.0f ? 0.5f
+                                            : 0.25f;
+        const float fade = std::max(behind, b.far_fade[i]) * b.top_fade[i];
+        const float alpha = opacity * level * fade * (0.35f + 0.65f * core) * spread;
+        b.hx[c][i] = hx, b.hy[c][i] = hy, b.tx[c][i] = tx, b.ty[c][i] = ty;
+        b.depth[c][i] = depth;
+        b.alpha[c][i] = visible ? alpha : 0.0f;
+        b.width[c][i] = true_width;
+      }
+    }
+  };
+  // What a streak leaves in a texel, unless a car nearer than it covers the texel.
+  const float* occluded = occlude(in, sx, sy, cx, cy);
+  auto put = [occluded](std::vector<Texel>& out, std::size_t i, float alpha, float depth) {
+    if (occluded && depth > occluded[i]) return;
+    out[i].alpha += alpha;
+    out[i].depth = std::min(out[i].depth, depth);
+  };
+  auto draw = [&](std::size_t begin, std::size_t end, std::vector<Texel>& out, Bounds& dirty,
+                  Batch& bt) {
+    std::uint32_t drawn = 0;
+    int lo_x = width, lo_y = height, hi_x = 0, hi_y = 0;
+    for (std::size_t first_drop = begin; first_drop < end; first_drop += kBatch) {
+      const int n = static_cast<int>(std::min<std::size_t>(kBatch, end - first_drop));
+      for (int i = 0; i < n; ++i) {
+        const glm::vec4& drop = rain.drops[first_drop + i];
+        bt.x[i] = drop.x, bt.y[i] = drop.y, bt.z[i] = drop.z, bt.diameter[i] = drop.w;
+        bt.speed[i] = speeds.at(drop.w);
+      }
+      project(bt, n);
+      for (int c = 0; c < copy_count; ++c) {
+        for (int i = 0; i < n; ++i) {
+          const float alpha = bt.alpha[c][i];
+          if (!(alpha > 0.0f)) continue;
+          ++drawn;
+          const float hx = bt.hx[c][i], hy = bt.hy[c][i], tx = bt.tx[c][i], ty = bt.ty[c][i];
+          const float depth = bt.depth[c][i], true_width = bt.width[c][i];
+          const float dx = tx - hx, dy = ty - hy;
+
+          // A Wu line, clipped to the layer: one texel a column along its major axis, shared by the
+          // two nearest across (and whole texels between them for a drop wider than a texel).
+          const bool x_major = std::abs(dx) >= std::abs(dy);
+          float a0 = x_major ? hx : hy, a1 = x_major ? tx : ty;  // along the major axis
+          float b0 = x_major ? hy : hx, b1 = x_major ? ty : tx;  // across
+          if (a1 < a0) {
+            std::swap(a0, a1);
+            std::swap(b0, b1);
+          }
+          const float slope = a1 - a0 > 1e-6f ? (b1 - b0) / (a1 - a0) : 0.0f;
+          const int major_size = x_major ? width : height, minor_size = x_major ? height : width;
+          int first = std::max(0, static_cast<int>(std::floor(a0)));
+          int last =
+              std::min({major_size - 1, static_cast<int>(std::floor(a1)), first + max_steps});
+          // Wide near drops cover whole texels between the two shared ones.
+          const int extra = std::min(static_cast<int>(true_width / px * 0.5f), kMaxExtraTexels);
+          // Clip the columns to those whose texels across lie inside the layer, so that the loop
+          // below needs no test per texel: b(m) = b0 + (m + 0.5 - a0) * slope - 0.5 must stay in
+          // [extra, minor_size - 2 - extra].
+          const float b_lo = static_cast<float>(extra),
+                      b_hi = static_cast<float>(minor_size - 2 - extra);
+          if (b_hi < b_lo) continue;
+          auto b_at = [&](float m) { return b0 + (m + 0.5f - a0) * slope - 0.5f; };
+          // Most streaks lie well inside across (b(m) stays within half a texel of [b0, b1] less
+          // half a texel): no clipping then.
+          const bool inside = std::min(b0, b1) - 1.0f >= b_lo && std::max(b0, b1) <= b_hi;
+          if (!inside && slope != 0.0f) {
+            // m where b(m) crosses b_lo and b_hi; the columns between them are inside.
+            const float m_lo = (b_lo + 0.5f - b0) / slope + a0 - 0.5f;
+            const float m_hi = (b_hi + 0.5f - b0) / slope + a0 - 0.5f;
+            // Within the layer before they become ints (a nearly flat streak's are far out).
+            const float m_min = std::clamp(std::min(m_lo, m_hi), -1.0f, float(major_size));
+            const float m_max = std::clamp(std::max(m_lo, m_hi), -1.0f, float(major_size));
+            first = std::max(first, static_cast<int>(std::ceil(m_min)));
+            last = std::min(last, static_cast<int>(std::floor(m_max)));
+            // Rounding at the ends: step inwards while a column is still outside.
+            while (first <= last && !(b_at(first) >= b_lo && b_at(first) <= b_hi)) ++first;
+            while (last >= first && !(b_at(last) >= b_lo && b_at(last) <= b_hi)) --last;
+          } else if (!inside && !(b_at(0.0f) >= b_lo && b_at(0.0f) <= b_hi)) {
+            continue;
+          }
+          if (first > last) continue;
+          const std::size_t major_stride = x_major ? 1 : static_cast<std::size_t>(width);
+          const std::size_t minor_stride = x_major ? static_cast<std::size_t>(width) : 1;
+          // The texels across stay in [base_lo, base_hi + 1 + extra]: b(m) is inside them but for
+          // rounding, which the clamp absorbs (a texel out of the layer would be written else).
+          const int base_lo = extra, base_hi = minor_size - 2 - extra;
+          // b(m) is linear: its extremes are at the ends.
+          int b_min =
+              std::clamp(static_cast<int>(std::min(b_at(first), b_at(last))), base_lo, base_hi);
+          int b_max =
+              std::clamp(static_cast<int>(std::max(b_at(first), b_at(last))), base_lo, base_hi);
+          for (int m = first; m <= last; ++m) {
+            // Evaluated afresh at each column (not summed), so that it stays between its ends.
+            const float b = b_at(static_cast<float>(m));
+            const int base = std::clamp(static_cast<int>(b), base_lo, base_hi);
+            const float frac = std::clamp(b - static_cast<float>(base), 0.0f, 1.0f);
+            std::size_t i = m * major_stride + (base - extra) * minor_stride;
+            put(out, i, alpha * (1.0f - frac), depth);
+            for (int k = 1 - extra; k <= extra; ++k) {
+              i += minor_stride;
+              put(out, i, alpha, depth);
+            }
+            put(out, i + minor_stride, alpha * frac, depth);
+          }
+          b_min -= extra;
+          b_max += extra + 2;
+          if (x_major) {
+            lo_x = std::min(lo_x, first), hi_x = std::max(hi_x, last + 1);
+            lo_y = std::min(lo_y, b_min), hi_y = std::max(hi_y, b_max);
+          } else {
+            lo_y = std::min(lo_y, first), hi_y = std::max(hi_y, last + 1);
+            lo_x = std::min(lo_x, b_min), hi_x = std::max(hi_x, b_max);
+          }
+        }
+      }
+    }
+    dirty = lo_x < hi_x && lo_y < hi_y ? Bounds{lo_x, lo_y, hi_x, hi_y} : Bounds{};
+    return drawn;
+  };
+  // Two halves of the drops on two threads, each into texels of its own, summed in a fixed order:
+  // the same drops give the same layer. A second thread pays for itself only past a few thousand
+  // drops.
+  const std::size_t half = rain.drops.size() >= kDropsForTwoThreads ? rain.drops.size() / 2 : 0;
+  Bounds dirty_first, dirty_second;
+  std::uint32_t drawn = 0;
+  if (half > 0) {
+    std::uint32_t drawn_second = 0;
+    helper_.start([&] { drawn_second = draw(0, half, second_, dirty_second, *batches_[1]); });
+    drawn = draw(half, rain.drops.size(), texels_, dirty_first, *batches_[0]);
+    helper_.wait();
+    drawn += drawn_second;
+  } else {
+    drawn = draw(0, rain.drops.size(), texels_, dirty_first, *batches_[0]);
+  }
+
+  const Bounds dirty_splashes = draw_splashes(rain, in, view, sx, sy, cx, cy);
+
+  // The texels with rain: the dirty rectangles of both threads and of the splashes.
+  Bounds b;
+  for (const Bounds& d : {dirty_first, dirty_second, dirty_splashes}) {
+    if (d.empty()) continue;
+    b = b.empty() ? d
+                  : Bounds{std::min(b.x0, d.x0), std::min(b.y0, d.y0), std::max(b.x1, d.x1),
+                           std::max(b.y1, d.y1)};
+  }
+  if (b.empty()) return drawn;
+
+  // Each texel's light and opacity, from tables: summed opacities combine as independent
+  // coverings, 1 - exp(-sum), whatever the order; the streaks carry the light, hazed by the
+  // distance of the nearest.
+  const CoverageTable& coverage = coverage_table();
+  glm::uvec3 hazed[kHazeSteps + 1];
+  for (int i = 0; i <= kHazeSteps; ++i) {
+    const glm::vec3 c = to_display(glm::mix(in.haze, in.light, transmittance[i]));
+    hazed[i] = glm::uvec3(c * 255.0f + 0.5f);
+  }
+  // The composite upsamples the colour smoothly but tests each pixel against the depth of its
+  // texel: the empty texels next to the streaks take their nearest neighbour's depth, so that the
+  // soft edge is drawn rather than cut at the texel's border.
+  const Bounds grown{std::max(b.x0 - 1, 0), std::max(b.y0 - 1, 0), std::min(b.x1 + 1, width),
+                     std::min(b.y1 + 1, height)};
+  auto lend_depth = [&](std::size_t i, float depth) {
+    if (colour_[i] != 0u) return;  // lit: its own depth (a texel lit later overwrites this)
+    depth_[i] = depth_[i] > 0.0f ? std::min(depth_[i], depth) : depth;
+  };
+  // Rows [y0, y1); the depths lent go to rows [lend_y0, lend_y1) only, so that two threads on
+  // two halves never write the same texel.
+  auto resolve_rows = [&](int y0, int y1, int lend_y0, int lend_y1) {
+    for (int y = y0; y < y1; ++y) {
+      const std::size_t row = static_cast<std::size_t>(y) * width;
+      for (int x = b.x0; x < b.x1; ++x) {
+        Texel& first = texels_[row + x];
+        Texel& second = second_[row + x];
+        if (first.depth == kUntouched && second.depth == kUntouched) continue;
+        // Read and leave clear for the next frame.
+        const Texel t = std::exchange(first, Texel{});
+        const Texel u = std::exchange(second, Texel{});
+        const float alpha = t.alpha + u.alpha;
+        if (alpha <= 0.0f) continue;
+        const float depth = std::min(t.depth, u.depth);
+        const std::uint32_t a = coverage.at(alpha);
+        const glm::uvec3& c = hazed[std::min(static_cast<int>(depth / kHazeStepM), kHazeSteps)];
+        // Premultiplied: each channel times the coverage, rounded, in bytes.
+        colour_[row + x] = ((c.r * a + 127) / 255) | ((c.g * a + 127) / 255) << 8 |
+                           ((c.b * a + 127) / 255) << 16 | a << 24;
+        depth_[row + x] = depth;
+        if (x > 0) lend_depth(row + x - 1, depth);
+        if (x + 1 < width) lend_depth(row + x + 1, depth);
+        if (y - 1 >= lend_y0) lend_depth(row - width, depth);
+        if (y + 1 < lend_y1) lend_depth(row + width, depth);
+      }
+    }
+  };
+  // Two halves of the rows on two threads; then the depths lent across the seam between them.
+  if (b.y1 - b.y0 < 32) {
+    resolve_rows(b.y0, b.y1, grown.y0, grown.y1);
+  } else {
+    const int mid = (b.y0 + b.y1) / 2;
+    helper_.start([&] { resolve_rows(mid, b.y1, mid, grown.y1); });
+    resolve_rows(b.y0, mid, grown.y0, mid);
+    helper_.wait();
+    const std::size_t above = static_cast<std::size_t>(mid - 1) * width;
+    const std::size_t below = above + width;
+    for (int x = b.x0; x < b.x1; ++x) {
+      if (colour_[above + x] != 0u) lend_depth(below + x, depth_[above + x]);
+      if (colour_[below + x] != 0u) lend_depth(above + x, depth_[below + x]);
+    }
+  }
+  bounds_ = grown;
+  return drawn;
+}
+
+const float* RainLayer::occlude(const RainLayerInputs& in, float sx, float sy, float cx, float cy) {
+  // Last frame's rectangles back to none.
+  for (int y = occluded_.y0; y < occluded_.y1; ++y) {
+    std::fill_n(occluder_depth_.begin() + static_cast<std::size_t>(y) * width_ + occluded_.x0,
+                occluded_.x1 - occluded_.x0, kUntouched);
+  }
+  occluded_ = Bounds{};
+  if (in.occluders.empty()) return nullptr;
+  for (const RainOccluder& o : in.occluders) {
+    // To the camera in double (the world is kilometres wide), then float.
+    const glm::mat4 to_camera(glm::dmat4(in.view) * o.to_world);
+    float near = kUntouched, x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
+    bool behind = false;
+    for (int c = 0; c < 8; ++c) {
+      const glm::vec3 corner((c & 1) ? o.hi.x : o.lo.x, (c & 2) ? o.hi.y : o.lo.y,
+                             (c & 4) ? o.hi.z : o.lo.z);
+      const glm::vec3 v(to_camera * glm::vec4(corner, 1.0f));
+      const float depth = -v.z;
+      if (depth < 0.1f) {
+        behind = true;  // a box around the camera or behind it: no rectangle to draw
+        break;
+      }
+      near = std::min(near, depth);
+      const float x = cx + sx * v.x / depth, y = cy + sy * v.y / depth;
+      x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+    }
+    if (behind) continue;
+    // The texels wholly inside the rectangle: its edge is the composite's per-pixel test.
+    const int ix0 = std::max(0, static_cast<int>(std::ceil(x0)));
+    const int iy0 = std::max(0, static_cast<int>(std::ceil(y0)));
+    const int ix1 = std::min(width_, static_cast<int>(std::floor(x1)));
+    const int iy1 = std::min(height_, static_cast<int>(std::floor(y1)));
+    if (ix0 >= ix1 || iy0 >= iy1) continue;
+    for (int y = iy0; y < iy1; ++y) {
+      float* row = &occluder_depth_[static_cast<std::size_t>(y) * width_];
+      for (int x = ix0; x < ix1; ++x) row[x] = std::min(row[x], near);
+    }
+    occluded_ = occluded_.empty()
+                    ? Bounds{ix0, iy0, ix1, iy1}
+                    : Bounds{std::min(occluded_.x0, ix0), std::min(occluded_.y0, iy0),
+                             std::max(occluded_.x1, ix1), std::max(occluded_.y1, iy1)};
+  }
+  return occluded_.empty() ? nullptr : occluder_depth_.data();
+}
+
+RainLayer::Bounds RainLayer::draw_splashes(const sim::RainState& rain, const RainLayerInputs& in,
+                                           const glm::mat4& view, float sx, float sy, float cx,
+                                           float cy) {
+  if (rain.splashes.empty()) return {};
+  // The car's frame to the camera's, for the splashes on it (they move with the car).
+  const glm::mat4 car_view(glm::dmat4(in.view) * in.vehicle_to_world);
+  int lo_x = width_, lo_y = height_, hi_x = 0, hi_y = 0;
+  // One point's light, shared by the four texels around it.
+  auto splat = [&](const glm::vec3& v, float alpha) {
+    const float depth = -v.z;
+    if (depth < kNearestSplashM) return;
+    const float x = cx + sx * v.x / depth - 0.5f, y = cy + sy * v.y / depth - 0.5f;
+    if (!(x >= 0.0f && y >= 0.0f && x < width_ - 1.0f && y < height_ - 1.0f)) return;
+    const int ix = static_cast<int>(x), iy = static_cast<int>(y);
+    const float fx = x - ix, fy = y - iy;
+    // A little nearer than the surface it stands on, so that the depth test keeps it over it.
+    const float biased = depth * 0.96f - 0.05f;
+    const std::size_t at = static_cast<std::size_t>(iy) * width_ + ix;
+    const float w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+    const std::size_t texel[4] = {at, at + 1, at + width_, at + width_ + 1};
+    for (int k = 0; k < 4; ++k) {
+      if (!occluded_.empty() && biased > occluder_depth_[texel[k]]) continue;
+      texels_[texel[k]].alpha += alpha * w[k];
+      texels_[texel[k]].depth = std::min(texels_[texel[k]].depth, biased);
+    }
+    lo_x = std::min(lo_x, ix), hi_x = std::max(hi_x, ix + 2);
+    lo_y = std::min(lo_y, iy), hi_y = std::max(hi_y, iy + 2);
+  };
+  const float dt = static_cast<float>(in.dt_s);
+  for (const sim::SplashState& s : rain.splashes) {
+    const float age = (s.age_s + dt) / static_cast<float>(sim::kSplashLifeS);
+    if (age < 0.0f || age > 1.0f) continue;
+    // The crown (Worthington's and Yarin's pictures of a drop on a wet surface): a ring of
+    // droplets that widens to several times the drop and rises about as high, then falls back.
+    const float d_m = s.diameter_mm * 1e-3f;
+    const float radius = d_m * (1.0f + 5.0f * age);
+    const float height = d_m * 5.0f * std::sin(3.14159265f * age);
+    const glm::mat4& m = s.on_car ? car_view : view;
+    const glm::vec3 centre(m * glm::vec4(s.position + glm::vec3(0.0f, 0.0f, 0.6f * height), 1.0f));
+    const float depth = -centre.z;
+    if (depth < kNearestSplashM) continue;
+    // Its wall's area seen from the camera, in texels, as opacity: a thin sheet of water, half
+    // of it hidden by the other half. The same across layer sizes, as the streaks.
+    const float texels_per_m = sy / depth;
+    const float wall = 2.0f * radius * height * texels_per_m * texels_per_m;
+    const float fade = 1.0f - age;
+    const float alpha_total = in.opacity * kSplashBrightness * std::min(wall, 4.0f) * fade;
+    if (alpha_total < 1e-3f) continue;
+    // A dot far away; a ring of points where the crown is a few texels wide.
+    const float ring_texels = 6.2832f * radius * texels_per_m;
+    const int points = std::clamp(static_cast<int>(ring_texels), 1, 16);
+    if (points < 3) {
+      splat(centre, alpha_total);
+      continue;
+    }
+    const glm::vec3 up(m * glm::vec4(0.0f, 0.0f, 1.0f, 0.0f));
+    const glm::vec3 e1(m * glm::vec4(radius, 0.0f, 0.0f, 0.0f));
+    const glm::vec3 e2(m * glm::vec4(0.0f, radius, 0.0f, 0.0f));
+    for (int k = 0; k < points; ++k) {
+      const float a = 6.2832f * (k + 0.5f * age) / points;
+      splat(centre + e1 * std::cos(a) + e2 * std::sin(a) + up * (0.4f * height),
+            alpha_total / points);
+    }
+  }
+  return lo_x < hi_x ? Bounds{lo_x, lo_y, hi_x, hi_y} : Bounds{};
+}
+
+}  // namespace downpour::render

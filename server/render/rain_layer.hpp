@@ -1,0 +1,122 @@
+// The rain streaks of one view, drawn on the CPU into a reduced-size layer that a pass composites
+// over the scene. On llvmpipe a GPU quad per drop costs about 0.8 us in vertex work and triangle
+// setup whatever its size (75,000 drops: 60-90 ms); here a streak costs its projection and a few
+// texels (a Wu line), so 80,000 fit in a few milliseconds. Each texel keeps the streaks' opacity,
+// summed so that the order of the drops does not matter, and the depth of its nearest streak,
+// which sets the haze between it and the camera and which the composite tests against the scene's.
+// No GL.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include <glm/ext/matrix_double4x4.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include "server/sim/rain_field.hpp"
+#include "server/sim/worker_thread.hpp"
+
+namespace downpour::render {
+
+// A box that hides the rain behind it (a car): its corners lo..hi in its own frame.
+struct RainOccluder {
+  glm::dmat4 to_world{1.0};
+  glm::vec3 lo{0.0f}, hi{0.0f};
+};
+
+struct RainLayerInputs {
+  glm::mat4 view{1.0f};  // world to camera (GL axes: looking down -z)
+  double tan_half_fov_x = 0.0;
+  double tan_half_fov_y = 0.0;
+  glm::dvec3 camera_velocity{0.0};  // world, m/s
+  double dt_s = 0.0;                // the frame's time after the drops' (they move on by it)
+  double exposure_s = 1.0 / 60.0;   // a view's camera that sets none: a streak is the motion in it
+  glm::vec3 light{0.5f};            // linear light a drop carries (before the haze)
+  glm::vec3 haze{0.5f};             // linear colour of the haze between the drop and the camera
+  float haze_per_m = 0.0f;          // extinction
+  float opacity = 0.55f;
+  float pixels_per_texel = 2.0f;     // the view's pixels per layer texel, across
+  glm::dmat4 vehicle_to_world{1.0};  // the ego car at the frame's time, for the splashes on it
+  // The cars in the rain. A texel keeps one depth, its nearest streak's, which the composite tests
+  // against the scene; in dense rain nearly every texel over a car ahead has a streak in front of
+  // it, so the streaks behind a car are left out here, against its box on the layer (the box's
+  // screen rectangle at its nearest depth).
+  std::span<const RainOccluder> occluders;
+};
+
+class RainLayer {
+ public:
+  RainLayer();
+  ~RainLayer();
+
+  // Clears and draws the drops' streaks into a width x height layer; returns the streaks drawn.
+  std::uint32_t build(const sim::RainState& rain, const RainLayerInputs& in, int width, int height);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  // Premultiplied RGBA8 rows bottom-up (GL's order), display-encoded like the scene's colour.
+  const std::vector<std::uint32_t>& colour() const { return colour_; }
+  // View depth (m) of the texel's nearest streak; 0 where there is none.
+  const std::vector<float>& depth() const { return depth_; }
+  // The texels with rain lie in [x0, x1) x [y0, y1) (rows bottom-up); empty if none.
+  struct Bounds {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    bool empty() const { return x1 <= x0 || y1 <= y0; }
+  };
+  const Bounds& bounds() const { return bounds_; }
+
+  // The nearest a drop is drawn: nearer, it is far out of focus for an eye or camera looking at the
+  // road, a faint blur that would be the largest streak of all.
+  static constexpr float kNearestM = 1.5f;
+  // Splashes on the bonnet are nearer than that to the driver; nothing lands nearer than this.
+  static constexpr float kNearestSplashM = 0.3f;
+  // A splash's crown is brighter than a streak of the same area: its droplets and sheet face
+  // every way and catch the sky.
+  static constexpr float kSplashBrightness = 2.0f;
+
+ private:
+  // What the streaks leave in a texel: one cache access per texel drawn. Every drop carries the
+  // same light, so a texel needs only how much of it and the distance of its nearest streak, for
+  // the depth test and the haze between.
+  // A texel no streak or splash has touched (whatever touches one lowers its depth).
+  static constexpr float kUntouched = 1e30f;
+  struct Texel {
+    float alpha = 0.0f;        // sum of the streaks' opacities
+    float depth = kUntouched;  // nearest streak (m)
+  };
+  // The most whole texels across a streak between its two shared ones (a drop a few texels
+  // wide, just past kNearestM).
+  static constexpr int kMaxExtraTexels = 4;
+  // Each drop is drawn in the box and in a copy to each side of it, and behind those three for a
+  // camera behind the box (rain_layer.cpp).
+  static constexpr int kMaxCopies = 6;
+  // Drops projected together (rain_layer.cpp), in arrays the compiler vectorizes.
+  static constexpr int kBatch = 256;
+  // Below this many drops one thread draws them all.
+  static constexpr std::size_t kDropsForTwoThreads = 4096;
+
+  // Splats the splashes' crowns into texels_, after the streaks; returns the texels touched.
+  Bounds draw_splashes(const sim::RainState& rain, const RainLayerInputs& in, const glm::mat4& view,
+                       float sx, float sy, float cx, float cy);
+
+  // The occluders' nearest depth per texel (kUntouched where none), over occluded_ only.
+  const float* occlude(const RainLayerInputs& in, float sx, float sy, float cx, float cy);
+
+  int width_ = 0, height_ = 0;
+  std::vector<float> occluder_depth_;
+  Bounds occluded_;
+  sim::WorkerThread helper_;
+  // Each thread's batch of drops being projected (rain_layer.cpp), made once.
+  struct Batch;
+  std::unique_ptr<Batch> batches_[2];  // draws half the drops, resolves half the rows
+  std::vector<Texel> texels_;
+  std::vector<Texel> second_;  // the second thread's
+  std::vector<std::uint32_t> colour_;
+  std::vector<float> depth_;
+  Bounds bounds_;
+};
+
+}  // namespace downpour::render

@@ -1,0 +1,63 @@
+// The interface between the C++ renderer and its shaders, defined once: texture units, the
+// per-frame uniform block (std140) and its binding. The build writes the GLSL side of it
+// (interface.glsl, made by downpour-shader-tool from these same lists), so that a binding number
+// or a block field cannot differ between the two. No GL.
+#pragma once
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec4.hpp>
+
+namespace downpour::render {
+
+// Texture units: X(C++ name, unit, GLSL sampler type, GLSL name, what it holds).
+#define DOWNPOUR_TEXTURE_UNITS(X)                                                                \
+  X(kNoise, 1, sampler2D, noise_tex, "value noise, 4 frequencies in rgba, repeating")            \
+  X(kAsphalt, 2, sampler2D, asphalt_tex, "asphalt relief: rgb normal, a height (seed 003, 3.1)") \
+  X(kGlassWater, 3, sampler2D, glass_water_tex,                                                  \
+    "the session's glass water map: normal uv, compressed height, coverage")                     \
+  X(kSceneBlur, 4, sampler2D, scene_blur_tex,                                                    \
+    "the scene outside the glass, an eighth of the view, mirrored repeat")                       \
+  X(kViewColour, 5, sampler2D, view_colour_tex, "the view's colour so far")                      \
+  X(kViewDepth, 6, sampler2D, view_depth_tex, "the view's depth so far (reversed-Z)")            \
+  X(kGlassLayer, 7, sampler2D, glass_layer_tex,                                                  \
+    "the water on the glass over the scene, reduced size, premultiplied")                        \
+  X(kRainLayer, 8, sampler2D, rain_layer_tex,                                                    \
+    "the rain streaks, reduced size, premultiplied (rain_layer.hpp)")                            \
+  X(kRainDepth, 9, sampler2D, rain_depth_tex, "the rain layer's nearest streak depth (m), 0 none")
+
+// The per-frame uniform block: X(GLSL type, name, comment). Every field is a vec4 or a mat4, so
+// the C++ struct below has the std140 layout as it is.
+#define DOWNPOUR_FRAME_BLOCK(X)                                                \
+  X(mat4, view_proj, "world to clip")                                          \
+  X(mat4, inv_view_proj, "clip to world")                                      \
+  X(vec4, camera_pos, "xyz world position of the camera")                      \
+  X(vec4, sun_dir, "xyz unit direction towards the sun")                       \
+  X(vec4, sun_radiance, "rgb direct sunlight reaching the ground")             \
+  X(vec4, sky_zenith, "rgb")                                                   \
+  X(vec4, sky_horizon, "rgb")                                                  \
+  X(vec4, ambient, "rgb light from the whole sky on an upward surface")        \
+  X(vec4, fog, "rgb colour, a extinction per metre")                           \
+  X(vec4, params, "x sim time (s), y overcast, z wetness, w rain rate (mm/h)") \
+  X(vec4, wind, "xy wind velocity (m/s, world)")
+
+inline constexpr unsigned kFrameBlockBinding = 0;
+
+namespace texture_unit {
+#define DOWNPOUR_UNIT_CONSTANT(name, unit, type, glsl, what) inline constexpr unsigned name = unit;
+DOWNPOUR_TEXTURE_UNITS(DOWNPOUR_UNIT_CONSTANT)
+#undef DOWNPOUR_UNIT_CONSTANT
+}  // namespace texture_unit
+
+namespace detail {
+using mat4 = glm::mat4;
+using vec4 = glm::vec4;
+}  // namespace detail
+
+struct FrameBlock {
+#define DOWNPOUR_BLOCK_FIELD(type, name, what) detail::type name;
+  DOWNPOUR_FRAME_BLOCK(DOWNPOUR_BLOCK_FIELD)
+#undef DOWNPOUR_BLOCK_FIELD
+};
+static_assert(sizeof(FrameBlock) % 16 == 0, "std140: vec4 and mat4 fields only");
+
+}  // namespace downpour::render

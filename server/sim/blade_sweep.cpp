@@ -1,0 +1,85 @@
+#include "server/sim/blade_sweep.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "server/sim/water.hpp"
+
+namespace downpour::sim {
+namespace {
+
+glm::dvec2 direction(float angle_rad) { return {std::cos(angle_rad), std::sin(angle_rad)}; }
+glm::dvec2 left_normal(glm::dvec2 d) { return {-d.y, d.x}; }
+
+}  // namespace
+
+BladeSweep::BladeSweep(const WaterConfig& config, std::uint64_t seed)
+    : config_(config), random_(seed, 3) {}
+
+void BladeSweep::sweep(const WaterInputs& in, MeshModel& mesh, ParticleModel& model) {
+  const WaterConfig& w = config_;
+  std::vector<ParticleModel::Particle>& particles = model.particles();
+  const double particle_mass = model.particle_mass();
+  const std::vector<MeshModel::Drop>& drops = mesh.drops();
+  const double rp = w.particle_radius_mm;
+  for (int b = 0; b < 2; ++b) {
+    const BladePose& before = in.blades_before[b];
+    const BladePose& after = in.blades_after[b];
+    const double turn = after.angle_rad - before.angle_rad;
+    if (turn == 0.0) continue;
+    const double side = turn > 0.0 ? 1.0 : -1.0;
+    const glm::dvec2 pivot(after.pivot_mm);
+    const glm::dvec2 d0 = direction(before.angle_rad), d1 = direction(after.angle_rad);
+    const glm::dvec2 n0 = side * left_normal(d0), n1 = side * left_normal(d1);
+    const double half = 0.5 * after.width_mm, length = after.length_mm;
+    auto swept = [&](glm::dvec2 p, double r, double* along) {
+      const glm::dvec2 rel = p - pivot;
+      *along = glm::dot(d1, rel);
+      if (*along < 0.0 || *along > length) return false;
+      return glm::dot(n0, rel) >= -half && glm::dot(n1, rel) < half + r;
+    };
+    double along;
+    for (ParticleModel::Particle& p : particles) {
+      if (swept(p.pos, rp, &along)) p.pos = pivot + along * d1 + (half + rp) * n1;
+    }
+    // The swept sector's bounding box (the arc between the tips bulges out to the tip of the
+    // middle direction, reached at length / cos(half the turn)), for a quick rejection.
+    const glm::dvec2 mid = direction(0.5f * (before.angle_rad + after.angle_rad));
+    const glm::dvec2 bulge = pivot + mid * (length / std::cos(0.5 * turn));
+    const glm::dvec2 tip0 = pivot + d0 * length, tip1 = pivot + d1 * length;
+    const glm::dvec2 lo = glm::min(glm::min(pivot, bulge), glm::min(tip0, tip1)) - half;
+    const glm::dvec2 hi = glm::max(glm::max(pivot, bulge), glm::max(tip0, tip1)) + half;
+    const std::size_t n = drops.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const MeshModel::Drop& d = drops[i];
+      if (!d.alive || d.pos.x < lo.x - d.radius || d.pos.y < lo.y - d.radius ||
+          d.pos.x > hi.x + d.radius || d.pos.y > hi.y + d.radius ||
+          !swept(d.pos, d.radius, &along)) {
+        continue;
+      }
+      // Particles are equal: the drop's water joins what the blade already carries, and whole
+      // particles' worth of it come off as particles here (a tiny trail drop alone makes none).
+      const double mass = d.mass;
+      mesh.remove(static_cast<int>(i));
+      if (particles.size() >= w.max_particles) {
+        wiped_off_ += mass;
+        continue;
+      }
+      carried_[b] += mass;
+      const int count = static_cast<int>(std::floor(carried_[b] / particle_mass + 1e-9));
+      carried_[b] = std::max(0.0, carried_[b] - count * particle_mass);
+      for (int k = 0; k < count; ++k) {
+        // One at the drop, the rest jittered about it, all ahead of the blade; overlaps resolve
+        // through repulsion.
+        const double jitter_along = k == 0 ? 0.0 : random_.uniform(-rp, rp);
+        const double jitter_ahead = k == 0 ? 0.0 : random_.uniform(0.0, 2.0 * rp);
+        particles.push_back({pivot + (along + jitter_along) * d1 + (half + rp + jitter_ahead) * n1,
+                             particle_mass, 0.0});
+      }
+    }
+  }
+}
+
+}  // namespace downpour::sim

@@ -1,0 +1,36 @@
+// The wiper blades on the water (seed 000, sections 1.2-1.3): a moving blade pushes
+// the particles it reaches to its leading edge and turns the mesh drops it touches into equal
+// particles. The test is continuous: a point ahead of the blade before the step and within reach
+// of it after was swept, however far the blade turned.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "server/sim/mesh_model.hpp"
+#include "server/sim/particle_model.hpp"
+#include "server/sim/random.hpp"
+
+namespace downpour::sim {
+
+struct WaterInputs;
+
+class BladeSweep {
+ public:
+  BladeSweep(const WaterConfig& config, std::uint64_t seed);
+
+  void sweep(const WaterInputs& inputs, MeshModel& mesh, ParticleModel& particles);
+  // Water each blade has gathered from drops but not yet a whole particle's worth, mg: it rides
+  // on the blade's edge (and counts as on the glass).
+  double carried() const { return carried_[0] + carried_[1]; }
+  // Touched by a blade with the particle budget spent: wiped off at once, mg.
+  double wiped_off() const { return wiped_off_; }
+
+ private:
+  WaterConfig config_;
+  RandomStream random_;
+  std::array<double, 2> carried_{};
+  double wiped_off_ = 0.0;
+};
+
+}  // namespace downpour::sim

@@ -1,0 +1,49 @@
+#include "server/sim/worker_thread.hpp"
+
+#include <stdexcept>
+#include <utility>
+
+namespace downpour::sim {
+
+WorkerThread::WorkerThread() : thread_([this] { run(); }) {}
+
+WorkerThread::~WorkerThread() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  cv_.notify_all();
+  thread_.join();
+}
+
+void WorkerThread::start(std::function<void()> job) {
+  {
+    std::lock_guard lock(mutex_);
+    if (busy_) throw std::logic_error("WorkerThread::start while a job is running");
+    job_ = std::move(job);
+    busy_ = true;
+  }
+  cv_.notify_all();
+}
+
+void WorkerThread::wait() {
+  std::unique_lock lock(mutex_);
+  cv_.wait(lock, [this] { return !busy_; });
+}
+
+void WorkerThread::run() {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    cv_.wait(lock, [this] { return stopping_ || job_; });
+    if (!job_) return;  // stopping, nothing left to run
+    std::function<void()> job = std::move(job_);
+    job_ = nullptr;
+    lock.unlock();
+    job();  // noexcept by contract: a job that throws ends the process here
+    lock.lock();
+    busy_ = false;
+    cv_.notify_all();
+  }
+}
+
+}  // namespace downpour::sim

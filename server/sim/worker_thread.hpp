@@ -1,0 +1,40 @@
+// A thread that runs one job at a time beside the thread that starts it, which waits for it when it
+// needs its result. The scheduler runs the simulation's step on one (the water steps while the
+// scene's passes, which need only the frame's inputs, are drawn; the job is the same code in the
+// same order on whichever thread, so lockstep runs stay bit-exact); the rain layer shares its work
+// with one. Starting a job costs a wake-up, not a thread.
+#pragma once
+
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <thread>
+
+namespace downpour::sim {
+
+class WorkerThread {
+ public:
+  WorkerThread();
+  ~WorkerThread();
+  WorkerThread(const WorkerThread&) = delete;
+  WorkerThread& operator=(const WorkerThread&) = delete;
+
+  // Starts `job` on the thread; the previous one must have been waited for. The job must not
+  // throw (catch inside it what it may throw, and keep it for whoever waits for it).
+  void start(std::function<void()> job);
+  // Returns once the started job has finished (at once if none is running).
+  void wait();
+
+ private:
+  void run();
+
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::function<void()> job_;   // guarded by mutex_
+  bool busy_ = false;           // guarded by mutex_
+  bool stopping_ = false;       // guarded by mutex_
+  std::exception_ptr failure_;  // guarded by mutex_
+  std::thread thread_;
+};
+
+}  // namespace downpour::sim
