@@ -151,11 +151,15 @@ class StalledReaderTest(ServerProcessCase):
             client.close_session(info.session_id)
 
     def test_a_paused_reader_finds_a_bounded_backlog(self):
-        bounded = self.backlog_after_a_pause(self.client, 3.0)
+        # Long enough for the server to make several windows' worth of frames: a sanitizer build
+        # renders 6-8 fps, which in 3 s barely filled the bounded window (24 frames against 17).
+        pause_s = 4.0 * TIME_SCALE
+        bounded = self.backlog_after_a_pause(self.client, pause_s)
         with DownpourClient(self.target, stream_window_kib=0) as grown:
-            unbounded = self.backlog_after_a_pause(grown, 3.0)
-        print(f"backlog after 3 s: {bounded} frames (256 KiB window), {unbounded} (gRPC's)")
-        # 640x360 frames are 14-20 KiB: 256 KiB hold 13-19 of them; 3 s at 30 fps are 90.
+            unbounded = self.backlog_after_a_pause(grown, pause_s)
+        print(f"backlog after {pause_s:g} s: {bounded} frames (256 KiB window), "
+              f"{unbounded} (gRPC's)")
+        # 640x360 frames are 14-20 KiB: 256 KiB hold 13-19 of them; 4 s at 30 fps are 120.
         self.assertLessEqual(bounded, 30)
         self.assertGreater(unbounded, 2 * bounded)
 
