@@ -43,7 +43,7 @@ void check(const sim::Simulation& simulation) {
   for (const sim::RainDrop& d : rain.drops()) {
     require(std::isfinite(d.position_m.x) && std::isfinite(d.position_m.y) &&
             std::isfinite(d.position_m.z));
-    require(d.diameter_mm >= rain.config().min_diameter_mm &&
+    require(d.diameter_mm >= rain.config().smallest_drawn_mm &&
             d.diameter_mm <= rain.config().max_diameter_mm);
   }
   // Its splashes as published: bounded, finite, young.
@@ -53,7 +53,7 @@ void check(const sim::Simulation& simulation) {
     require(std::isfinite(s.position.x) && std::isfinite(s.position.y) &&
             std::isfinite(s.position.z));
     require(s.age_s >= 0.0f && s.age_s <= sim::kSplashLifeS + 1e-6);
-    require(s.diameter_mm >= rain.config().min_diameter_mm - 1e-6 &&
+    require(s.diameter_mm >= rain.config().smallest_drawn_mm - 1e-6 &&
             s.diameter_mm <= rain.config().max_diameter_mm + 1e-6);
   }
   for (const auto& d : water.drops()) {

@@ -46,6 +46,13 @@ double marshall_palmer_flux(double rain_mm_h, double d_min_mm, double d_max_mm) 
   return kMarshallPalmerN0 * (inside + tail);
 }
 
+double RainFieldConfig::drawn_min_diameter_mm(double rain_mm_h) const {
+  if (!(rain_mm_h > 0.0) || rain_mm_h >= full_tail_mm_h) return min_diameter_mm;
+  return std::max(smallest_drawn_mm, min_diameter_mm *
+                                         marshall_palmer_slope_per_mm(full_tail_mm_h) /
+                                         marshall_palmer_slope_per_mm(rain_mm_h));
+}
+
 RainField::RainField(std::uint64_t seed, RainFieldConfig config)
     : config_(config), random_(seed, 4) {}
 
@@ -53,7 +60,8 @@ std::uint32_t RainField::target_count(const Weather& weather) const {
   if (!(weather.rain_rate_mm_h > 0.0)) return 0;
   if (weather.rain_streak_count > 0) return std::min(weather.rain_streak_count, kMaxRainDrops);
   const double n = config_.volume_m3() *
-                   marshall_palmer_density(weather.rain_rate_mm_h, config_.min_diameter_mm);
+                   marshall_palmer_density(weather.rain_rate_mm_h,
+                                           config_.drawn_min_diameter_mm(weather.rain_rate_mm_h));
   return static_cast<std::uint32_t>(std::min<double>(std::lround(n), kMaxRainDrops));
 }
 
@@ -85,10 +93,10 @@ RainDrop RainField::born(const Box& box, double rain_mm_h, bool anywhere_in_heig
   // drawn from N(D) and kept in proportion to their speed, so that the box keeps N(D).
   const double slope = marshall_palmer_slope_per_mm(rain_mm_h);
   const double fastest = terminal_speed_mps(config_.max_diameter_mm);
+  const double smallest = config_.drawn_min_diameter_mm(rain_mm_h);
   for (;;) {
     const double u = random_.uniform();
-    d.diameter_mm =
-        std::min(config_.max_diameter_mm, config_.min_diameter_mm - std::log1p(-u) / slope);
+    d.diameter_mm = std::min(config_.max_diameter_mm, smallest - std::log1p(-u) / slope);
     d.speed_mps = terminal_speed_mps(d.diameter_mm);
     if (anywhere_in_height || random_.uniform() * fastest <= d.speed_mps) break;
   }

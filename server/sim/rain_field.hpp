@@ -1,18 +1,19 @@
 // Rain in the air (seed 004, with the physics of Marshall-Palmer and Atlas): the falling drops
 // near the car, as the renderer draws them as streaks, and the extinction that hides the rest.
 //
-// The field holds the drops of at least `min_diameter_mm` inside a box that travels with the car:
-// `length_m` ahead from `behind_m` behind the eye, `width_m` across, from the ground up `height_m`.
-// Their number is the box's volume times the Marshall-Palmer number density above that size, so it
-// follows the rain rate (Weather::rain_streak_count overrides it). Each drop keeps the size it was
-// born with and falls at the Atlas terminal speed of that size, tilted by Weather::rain_angle_deg
-// (about the car's forward axis, as the paper's control tilts the rain on screen) and drifting with
-// the wind. A drop that reaches the ground restarts at the top of the box at a new place; drops the
-// car leaves behind wrap to the front, so the drops stay where they are in the world while in the
-// box. A drop that lands on the road, the car's bonnet, boot or roof leaves a splash there: a crown
-// of droplets for kSplashLifeS, so that the splashes' rate is the large drops' flux and follows the
-// rain rate. The field steps at a fixed rate of its own, on the simulation's sub-steps: the same
-// seed and inputs give the same drops. No GL.
+// The field holds the distribution's large drops, those of at least `drawn_min_diameter_mm(R)`,
+// inside a box that travels with the car: `length_m` ahead from `behind_m` behind the eye,
+// `width_m` across, from the ground up `height_m`. Their number is the box's volume times the
+// Marshall-Palmer number density above that size, so it follows the rain rate
+// (Weather::rain_streak_count overrides it). Each drop keeps the size it was born with and falls at
+// the Atlas terminal speed of that size, tilted by Weather::rain_angle_deg (about the car's forward
+// axis, as the paper's control tilts the rain on screen) and drifting with the wind. A drop that
+// reaches the ground restarts at the top of the box at a new place; drops the car leaves behind
+// wrap to the front, so the drops stay where they are in the world while in the box. A drop that
+// lands on the road, the car's bonnet, boot or roof leaves a splash there: a crown of droplets for
+// kSplashLifeS, so that the splashes' rate is the large drops' flux and follows the rain rate. The
+// field steps at a fixed rate of its own, on the simulation's sub-steps: the same seed and inputs
+// give the same drops. No GL.
 #pragma once
 
 #include <cstdint>
@@ -52,7 +53,16 @@ inline constexpr double kSplashLifeS = 0.06;
 inline constexpr std::size_t kMaxRainSplashes = 16384;
 
 struct RainFieldConfig {
-  double min_diameter_mm = 2.5;  // smaller drops make faint streaks; they are in the extinction
+  // The smallest drop drawn from `full_tail_mm_h` (moderate rain) up; smaller drops make faint
+  // streaks, and are in the extinction. In lighter rain the drawn drops are the same share of the
+  // distribution as at that rate: Marshall-Palmer's sizes scale as 1/L, so the smallest drawn is
+  // min_diameter_mm (R / full_tail_mm_h)^0.21 (2.1 mm at 2 mm/h), and light rain shows sparse
+  // streaks of smaller drops (about 2,400 at 2 mm/h, against 500 with 2.5 mm at every rate, and
+  // 9,000 at 10 mm/h).
+  // Never under smallest_drawn_mm (below about 0.06 mm/h), so a trace of rain draws next to none.
+  double min_diameter_mm = 2.5;
+  double full_tail_mm_h = 5.0;
+  double smallest_drawn_mm = 1.0;
   double max_diameter_mm = 6.0;  // larger ones break up as they fall
   double behind_m = 2.0;         // the box's back, behind the eye
   double length_m = 24.0;        // along the car's heading
@@ -62,6 +72,7 @@ struct RainFieldConfig {
   double eye_height_m = 1.2;   // the box is centred on the driver's eye, not the axle
   double eye_forward_m = 1.3;  // from the pose's reference point
   double volume_m3() const { return length_m * width_m * height_m; }
+  double drawn_min_diameter_mm(double rain_mm_h) const;
 };
 
 struct RainDrop {

@@ -58,13 +58,21 @@ TEST(RainFieldTest, TheCountFollowsMarshallPalmerUnlessOverridden) {
   RainField field(7);
   const RainFieldConfig& c = field.config();
   for (double mm_h : {2.0, 10.0, 50.0}) {
-    const double expected =
-        std::min(80000.0, c.volume_m3() * marshall_palmer_density(mm_h, c.min_diameter_mm));
+    const double expected = std::min(
+        80000.0, c.volume_m3() * marshall_palmer_density(mm_h, c.drawn_min_diameter_mm(mm_h)));
     run(field, 0.2, rain(mm_h), driving(0.0));
     EXPECT_NEAR(static_cast<double>(field.drops().size()), expected, 0.05 * expected) << mm_h;
   }
-  // More rain, more drops: a few hundred in drizzle, the paper's ten thousand in heavy rain.
-  EXPECT_LT(field.target_count(rain(2.0)), 1000u);
+  // More rain, more drops: light rain draws the same share of its (smaller) drops as 5 mm/h, a
+  // couple of thousand at 2 mm/h; the paper's ten thousand in heavy rain; above 5 mm/h, all the
+  // drops of 2.5 mm or more.
+  EXPECT_NEAR(c.drawn_min_diameter_mm(2.0), 2.5 * std::pow(2.0 / 5.0, 0.21), 1e-9);
+  EXPECT_EQ(c.drawn_min_diameter_mm(10.0), 2.5);
+  EXPECT_EQ(c.drawn_min_diameter_mm(0.01), c.smallest_drawn_mm);
+  EXPECT_LT(field.target_count(rain(0.001)), 10u);  // a trace of rain draws next to none
+  EXPECT_NEAR(static_cast<double>(field.target_count(rain(2.0))) / field.target_count(rain(5.0)),
+              std::pow(2.0 / 5.0, 0.21), 0.01);
+  EXPECT_NEAR(field.target_count(rain(2.0)), 2400.0, 200.0);
   EXPECT_NEAR(field.target_count(rain(10.0)), 10000.0, 2000.0);
   EXPECT_GT(field.target_count(rain(50.0)), 60000u);
   Weather counted = rain(10.0);
@@ -175,7 +183,8 @@ TEST(RainFieldTest, SplashesLandAtTheFluxOnTheRoadAndOnTheCarNoneInsideIt) {
     const std::uint64_t road0 = field.road_splashes(), car0 = field.car_splashes();
     constexpr double kSeconds = 4.0;
     run(field, kSeconds, rain(mm_h), car);
-    const double flux = marshall_palmer_flux(mm_h, c.min_diameter_mm, c.max_diameter_mm);
+    const double flux =
+        marshall_palmer_flux(mm_h, c.drawn_min_diameter_mm(mm_h), c.max_diameter_mm);
     namespace body = car_body;
     const double car_area = (body::kHullFrontX - body::kHullRearX) * 2.0 * body::kHullHalfWidth;
     const double road_area = c.length_m * c.width_m - car_area;
