@@ -30,10 +30,9 @@ class WorkerThread {
 
   std::mutex mutex_;
   std::condition_variable cv_;
-  std::function<void()> job_;   // guarded by mutex_
-  bool busy_ = false;           // guarded by mutex_
-  bool stopping_ = false;       // guarded by mutex_
-  std::exception_ptr failure_;  // guarded by mutex_
+  std::function<void()> job_;  // guarded by mutex_
+  bool busy_ = false;          // guarded by mutex_
+  bool stopping_ = false;      // guarded by mutex_
   std::thread thread_;
 };
 

@@ -119,6 +119,17 @@ class ServerTest : public ::testing::Test {
     EXPECT_TRUE(stub->CloseSession(&ctx, req, &resp).ok());
   }
 
+  // A stub on its own connection with a small, fixed flow-control window (no BDP growth): a
+  // reader that stops reading stops taking data after a few frames, like a stuck client.
+  static std::unique_ptr<Downpour::Stub> small_window_stub() {
+    grpc::ChannelArguments args;
+    args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
+    args.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 64 * 1024);
+    args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
+    return Downpour::NewStub(
+        grpc::CreateCustomChannel(g_server->target(), grpc::InsecureChannelCredentials(), args));
+  }
+
   grpc::Status step(const std::string& id, double t, double dt, v1::StepResponse* out) {
     grpc::ClientContext ctx;
     ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
@@ -232,12 +243,7 @@ TEST_F(ServerTest, DriveEndsWithAStatusWhenItsSessionClosesWhileTheReaderPauses)
   const std::string id = create(
       v1::MODE_LOCKSTEP, {view(v1::VIEW_COCKPIT, 1280, 720), view(v1::VIEW_ROAD, 1280, 720)});
   // Its own connection with a small, fixed flow-control window: the server's writes stall.
-  grpc::ChannelArguments args;
-  args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
-  args.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 64 * 1024);
-  args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
-  auto slow_stub = Downpour::NewStub(
-      grpc::CreateCustomChannel(g_server->target(), grpc::InsecureChannelCredentials(), args));
+  auto slow_stub = small_window_stub();
   grpc::ClientContext ctx;
   ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
   auto stream = slow_stub->Drive(&ctx);
@@ -477,12 +483,7 @@ TEST_F(ServerTest, StalledReaderNeitherGrowsMemoryNorSlowsAnotherSession) {
 
   // A reader on its own connection with a small, fixed flow-control window (no BDP growth), so
   // that it stops accepting data after a few frames, like a stuck client.
-  grpc::ChannelArguments args;
-  args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
-  args.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 64 * 1024);
-  args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
-  auto stalled_stub = Downpour::NewStub(
-      grpc::CreateCustomChannel(g_server->target(), grpc::InsecureChannelCredentials(), args));
+  auto stalled_stub = small_window_stub();
   grpc::ClientContext stalled_ctx;
   auto stalled = stalled_stub->WatchFrames(&stalled_ctx, req);  // never Read()
   std::this_thread::sleep_for(std::chrono::seconds(2));         // flow-control windows fill up
