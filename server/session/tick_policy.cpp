@@ -7,7 +7,11 @@
 namespace downpour::session {
 namespace {
 
+// The achieved rate is measured over the last second; a session slower than that (a frame or two
+// a second) over its last few ticks, as far back as the long window.
 constexpr Clock::duration kRateWindow = std::chrono::seconds(1);
+constexpr Clock::duration kSlowRateWindow = std::chrono::seconds(10);
+constexpr std::size_t kSlowRateTicks = 3;
 
 }  // namespace
 
@@ -46,7 +50,9 @@ std::uint64_t TickPolicy::pass_slot(Schedule& s, Clock::time_point now) {
 void TickPolicy::note_tick(Schedule& s, Clock::time_point now) {
   ++s.ticks;
   s.recent.push_back(now);
-  while (!s.recent.empty() && now - s.recent.front() > kRateWindow) s.recent.pop_front();
+  while (s.recent.size() > kSlowRateTicks && now - s.recent.front() > kRateWindow)
+    s.recent.pop_front();
+  while (!s.recent.empty() && now - s.recent.front() > kSlowRateWindow) s.recent.pop_front();
 }
 
 std::optional<TickPolicy::Tick> TickPolicy::next(Clock::time_point now,
@@ -118,14 +124,26 @@ TickStats TickPolicy::stats(std::uint64_t session, Clock::time_point now) const 
   out.ticks = s.ticks;
   out.frames_late = s.frames_late;
   out.target_fps = s.fps;
-  // Ticks within the last second over the time they span; no rate until they span half a second
-  // (two ticks close together say little).
+  // Ticks within the last second over the time they span, once they span half a second (two
+  // ticks close together say little). A slower session: its last few ticks within the long window.
+  // Either way no more than one over the time since the last tick, so a session that stops
+  // rendering shows its rate falling, not the rate it last had.
   std::size_t recent = 0;
   for (auto t : s.recent) recent += now - t <= kRateWindow;
+  const bool fast = recent >= 2 && s.recent.back() - s.recent[s.recent.size() - recent] >=
+                                       std::chrono::milliseconds(500);
+  if (!fast) {
+    recent = 0;
+    for (auto t : s.recent) recent += now - t <= kSlowRateWindow;
+  }
   if (recent >= 2) {
     const Clock::time_point first = s.recent[s.recent.size() - recent];
     const double span = std::chrono::duration<double>(s.recent.back() - first).count();
-    if (span >= 0.5) out.achieved_fps = (recent - 1) / span;
+    const double since_last = std::chrono::duration<double>(now - s.recent.back()).count();
+    if (span > 0.0) {
+      out.achieved_fps = (recent - 1) / span;
+      if (since_last > 0.0) out.achieved_fps = std::min(out.achieved_fps, 1.0 / since_last);
+    }
   }
   return out;
 }

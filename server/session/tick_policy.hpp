@@ -31,7 +31,7 @@ struct TickStats {
   // Realtime frame slots that passed without a frame: the loop was busy elsewhere or the encoders
   // were full. A session that keeps its rate has none.
   std::uint64_t frames_late = 0;
-  double achieved_fps = 0.0;  // ticks over the last second
+  double achieved_fps = 0.0;  // ticks a second, over the last second or the last few ticks
   double target_fps = 0.0;    // realtime: its rate; lockstep: 0
 };
 
@@ -75,7 +75,7 @@ class TickPolicy {
     Clock::time_point last_tick;  // realtime: for the step's dt
     std::uint64_t ticks = 0;
     std::uint64_t frames_late = 0;
-    std::deque<Clock::time_point> recent;  // tick times within the last second
+    std::deque<Clock::time_point> recent;  // tick times: the last second's, or the last few
     double charged_s = 0.0;                // render thread time used, from the credit on waking
   };
   // Moves a realtime schedule past a slot served (or dropped) at `now`; returns the slots missed.

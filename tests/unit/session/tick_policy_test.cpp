@@ -58,6 +58,27 @@ TEST(TickPolicyTest, RealtimeSessionsTickAtTheirRate) {
   EXPECT_EQ(loop.policy.stats(1, loop.now).target_fps, 30.0);
 }
 
+TEST(TickPolicyTest, ASessionSlowerThanAFrameASecondStillShowsItsRate) {
+  // Each tick takes 1.25 s (a heavy view on a slow build): 0.8 fps, not 0.
+  FakeLoop loop;
+  loop.policy.add(1, sim::Mode::kRealtime, 60.0, loop.now);
+  loop.run(10s, 1ms, 1250ms);
+  EXPECT_NEAR(loop.policy.stats(1, loop.now).achieved_fps, 0.8, 0.05);
+  EXPECT_GT(loop.policy.stats(1, loop.now).frames_late, 400u);
+}
+
+TEST(TickPolicyTest, ASessionThatStopsRenderingShowsItsRateFalling) {
+  FakeLoop loop;
+  loop.policy.add(1, sim::Mode::kRealtime, 30.0, loop.now);
+  loop.run(3s, 1ms, 2ms);
+  EXPECT_NEAR(loop.policy.stats(1, loop.now).achieved_fps, 30.0, 0.5);
+  loop.encoders_full[1] = true;  // its readers stop reading
+  loop.run(2s, 1ms, 2ms);
+  EXPECT_NEAR(loop.policy.stats(1, loop.now).achieved_fps, 0.5, 0.05);
+  loop.run(20s, 1ms, 2ms);
+  EXPECT_EQ(loop.policy.stats(1, loop.now).achieved_fps, 0.0);
+}
+
 TEST(TickPolicyTest, TheRealtimeStepIsTheTimeSinceTheLastTickCapped) {
   FakeLoop loop;
   loop.policy.add(1, sim::Mode::kRealtime, 20.0, loop.now);
