@@ -59,6 +59,27 @@ const CoverageTable& coverage_table() {
   return table;
 }
 
+// The convex hull of eight points, counter-clockwise (Andrew's monotone chain); returns its size.
+int convex_hull(const glm::vec2 (&points)[8], glm::vec2 (&hull)[16]) {
+  glm::vec2 p[8];
+  std::copy(std::begin(points), std::end(points), p);
+  std::sort(p, p + 8,
+            [](glm::vec2 a, glm::vec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  auto turn = [](glm::vec2 o, glm::vec2 a, glm::vec2 b) {
+    return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+  };
+  int n = 0;
+  for (int i = 0; i < 8; ++i) {  // lower
+    while (n >= 2 && turn(hull[n - 2], hull[n - 1], p[i]) <= 0.0f) --n;
+    hull[n++] = p[i];
+  }
+  for (int i = 6, lower = n + 1; i >= 0; --i) {  // upper
+    while (n >= lower && turn(hull[n - 2], hull[n - 1], p[i]) <= 0.0f) --n;
+    hull[n++] = p[i];
+  }
+  return n - 1;  // the last point is the first again
+}
+
 }  // namespace
 
 struct RainLayer::Batch {
@@ -85,17 +106,18 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
     occluder_depth_.assign(texels, kUntouched);
     occluded_ = Bounds{};
     second_.assign(texels, Texel{});
-    depth_.assign(texels, 0.0f);
     colour_.assign(texels, 0u);
+    tiles_x_ = (width + kTile - 1) / kTile;
+    tile_lit_.assign(static_cast<std::size_t>(tiles_x_) * ((height + kTile - 1) / kTile), 0);
   } else {
-    // The texels were left clear by the last resolve; the outputs are cleared where it wrote.
+    // The texels were left clear by the last resolve; the output is cleared where it wrote.
     for (int y = bounds_.y0; y < bounds_.y1; ++y) {
       const std::size_t row = static_cast<std::size_t>(y) * width + bounds_.x0;
-      std::fill_n(depth_.begin() + row, bounds_.x1 - bounds_.x0, 0.0f);
       std::fill_n(colour_.begin() + row, bounds_.x1 - bounds_.x0, 0u);
     }
   }
   bounds_ = Bounds{};
+  runs_.clear();
   if (rain.drops.empty() || width <= 0 || height <= 0) return 0;
 
   const glm::vec3 fall = rain.fall_direction;
@@ -219,9 +241,11 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
       }
     }
   };
-  // What a streak leaves in a texel, unless a car nearer than it covers the texel.
-  const float* occluded = occlude(in, sx, sy, cx, cy);
-  auto put = [occluded](std::vector<Texel>& out, std::size_t i, float alpha, float depth) {
+  // What a streak leaves in a texel, unless a car nearer than it covers the texel (`occluded`: the
+  // occluders' depths, or null for a streak that lies wholly outside them).
+  const float* const occluded = occlude(in, sx, sy, cx, cy);
+  auto put = [](std::vector<Texel>& out, const float* occluded, std::size_t i, float alpha,
+                float depth) {
     if (occluded && depth > occluded[i]) return;
     out[i].alpha += alpha;
     out[i].depth = std::min(out[i].depth, depth);
@@ -299,18 +323,27 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
               std::clamp(static_cast<int>(std::min(b_at(first), b_at(last))), base_lo, base_hi);
           int b_max =
               std::clamp(static_cast<int>(std::max(b_at(first), b_at(last))), base_lo, base_hi);
+          // The occluders' depths only for a streak whose texels may lie inside one: most lie
+          // wholly outside them, and the lookups would be a second cache miss per texel.
+          const int minor_lo = b_min - extra, minor_hi = b_max + extra + 2;
+          const bool near_occluder =
+              occluded && (x_major ? first < occluded_.x1 && last >= occluded_.x0 &&
+                                         minor_lo < occluded_.y1 && minor_hi > occluded_.y0
+                                   : first < occluded_.y1 && last >= occluded_.y0 &&
+                                         minor_lo < occluded_.x1 && minor_hi > occluded_.x0);
+          const float* occ = near_occluder ? occluded : nullptr;
           for (int m = first; m <= last; ++m) {
             // Evaluated afresh at each column (not summed), so that it stays between its ends.
             const float b = b_at(static_cast<float>(m));
             const int base = std::clamp(static_cast<int>(b), base_lo, base_hi);
             const float frac = std::clamp(b - static_cast<float>(base), 0.0f, 1.0f);
             std::size_t i = m * major_stride + (base - extra) * minor_stride;
-            put(out, i, alpha * (1.0f - frac), depth);
+            put(out, occ, i, alpha * (1.0f - frac), depth);
             for (int k = 1 - extra; k <= extra; ++k) {
               i += minor_stride;
-              put(out, i, alpha, depth);
+              put(out, occ, i, alpha, depth);
             }
-            put(out, i + minor_stride, alpha * frac, depth);
+            put(out, occ, i + minor_stride, alpha * frac, depth);
           }
           b_min -= extra;
           b_max += extra + 2;
@@ -364,20 +397,11 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
     const glm::vec3 c = to_display(glm::mix(in.haze, in.light, transmittance[i]));
     hazed[i] = glm::uvec3(c * 255.0f + 0.5f);
   }
-  // The composite upsamples the colour smoothly but tests each pixel against the depth of its
-  // texel: the empty texels next to the streaks take their nearest neighbour's depth, so that the
-  // soft edge is drawn rather than cut at the texel's border.
-  const Bounds grown{std::max(b.x0 - 1, 0), std::max(b.y0 - 1, 0), std::min(b.x1 + 1, width),
-                     std::min(b.y1 + 1, height)};
-  auto lend_depth = [&](std::size_t i, float depth) {
-    if (colour_[i] != 0u) return;  // lit: its own depth (a texel lit later overwrites this)
-    depth_[i] = depth_[i] > 0.0f ? std::min(depth_[i], depth) : depth;
-  };
-  // Rows [y0, y1); the depths lent go to rows [lend_y0, lend_y1) only, so that two threads on
-  // two halves never write the same texel.
-  auto resolve_rows = [&](int y0, int y1, int lend_y0, int lend_y1) {
+  // Rows [y0, y1), whole rows of tiles but at the layer's ends (two threads mark tiles apart).
+  auto resolve_rows = [&](int y0, int y1) {
     for (int y = y0; y < y1; ++y) {
       const std::size_t row = static_cast<std::size_t>(y) * width;
+      std::uint8_t* tiles = &tile_lit_[static_cast<std::size_t>(y / kTile) * tiles_x_];
       for (int x = b.x0; x < b.x1; ++x) {
         Texel& first = texels_[row + x];
         Texel& second = second_[row + x];
@@ -393,30 +417,51 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
         // Premultiplied: each channel times the coverage, rounded, in bytes.
         colour_[row + x] = ((c.r * a + 127) / 255) | ((c.g * a + 127) / 255) << 8 |
                            ((c.b * a + 127) / 255) << 16 | a << 24;
-        depth_[row + x] = depth;
-        if (x > 0) lend_depth(row + x - 1, depth);
-        if (x + 1 < width) lend_depth(row + x + 1, depth);
-        if (y - 1 >= lend_y0) lend_depth(row - width, depth);
-        if (y + 1 < lend_y1) lend_depth(row + width, depth);
+        // The tile, and which of its edges has rain (bilinear magnification carries a quarter of
+        // an edge texel into the next tile's first pixels).
+        const int tx = x % kTile, ty = y % kTile;
+        tiles[x / kTile] |= kTileLit | (tx == 0 ? kTileLeft : 0) |
+                            (tx == kTile - 1 ? kTileRight : 0) | (ty == 0 ? kTileBottom : 0) |
+                            (ty == kTile - 1 ? kTileTop : 0);
       }
     }
   };
-  // Two halves of the rows on two threads; then the depths lent across the seam between them.
-  if (b.y1 - b.y0 < 32) {
-    resolve_rows(b.y0, b.y1, grown.y0, grown.y1);
+  // Two halves of the rows on two threads, split between rows of tiles.
+  const int mid = (b.y0 + b.y1) / 2 / kTile * kTile;
+  if (b.y1 - b.y0 < 32 || mid <= b.y0) {
+    resolve_rows(b.y0, b.y1);
   } else {
-    const int mid = (b.y0 + b.y1) / 2;
-    helper_.start([&] { resolve_rows(mid, b.y1, mid, grown.y1); });
-    resolve_rows(b.y0, mid, grown.y0, mid);
+    helper_.start([&] { resolve_rows(mid, b.y1); });
+    resolve_rows(b.y0, mid);
     helper_.wait();
-    const std::size_t above = static_cast<std::size_t>(mid - 1) * width;
-    const std::size_t below = above + width;
-    for (int x = b.x0; x < b.x1; ++x) {
-      if (colour_[above + x] != 0u) lend_depth(below + x, depth_[above + x]);
-      if (colour_[below + x] != 0u) lend_depth(above + x, depth_[below + x]);
+  }
+  bounds_ = b;
+  // The runs of tiles to draw, row by row: those with rain and those beside a lit edge of one.
+  const int tiles_y = static_cast<int>(tile_lit_.size()) / tiles_x_;
+  const int tx0 = std::max(b.x0 / kTile - 1, 0), tx1 = std::min((b.x1 - 1) / kTile + 2, tiles_x_);
+  const int ty0 = std::max(b.y0 / kTile - 1, 0), ty1 = std::min((b.y1 - 1) / kTile + 2, tiles_y);
+  auto at = [&](int tx, int ty) -> std::uint8_t {
+    return tx < 0 || ty < 0 || tx >= tiles_x_ || ty >= tiles_y
+               ? 0
+               : tile_lit_[static_cast<std::size_t>(ty) * tiles_x_ + tx];
+  };
+  auto drawn_tile = [&](int tx, int ty) {
+    return (at(tx, ty) & kTileLit) || (at(tx - 1, ty) & kTileRight) ||
+           (at(tx + 1, ty) & kTileLeft) || (at(tx, ty - 1) & kTileTop) ||
+           (at(tx, ty + 1) & kTileBottom);
+  };
+  for (int ty = ty0; ty < ty1; ++ty) {
+    for (int tx = tx0; tx < tx1; ++tx) {
+      if (!drawn_tile(tx, ty)) continue;
+      const int first = tx;
+      while (tx < tx1 && drawn_tile(tx, ty)) ++tx;
+      runs_.push_back({first * kTile, ty * kTile, std::min(tx * kTile, width),
+                       std::min((ty + 1) * kTile, height)});
     }
   }
-  bounds_ = grown;
+  for (int ty = ty0; ty < ty1; ++ty) {
+    std::fill_n(tile_lit_.begin() + static_cast<std::size_t>(ty) * tiles_x_ + tx0, tx1 - tx0, 0);
+  }
   return drawn;
 }
 
@@ -431,7 +476,8 @@ const float* RainLayer::occlude(const RainLayerInputs& in, float sx, float sy, f
   for (const RainOccluder& o : in.occluders) {
     // To the camera in double (the world is kilometres wide), then float.
     const glm::mat4 to_camera(glm::dmat4(in.view) * o.to_world);
-    float near = kUntouched, x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
+    float near = kUntouched;
+    glm::vec2 corners[8];
     bool behind = false;
     for (int c = 0; c < 8; ++c) {
       const glm::vec3 corner((c & 1) ? o.hi.x : o.lo.x, (c & 2) ? o.hi.y : o.lo.y,
@@ -439,28 +485,42 @@ const float* RainLayer::occlude(const RainLayerInputs& in, float sx, float sy, f
       const glm::vec3 v(to_camera * glm::vec4(corner, 1.0f));
       const float depth = -v.z;
       if (depth < 0.1f) {
-        behind = true;  // a box around the camera or behind it: no rectangle to draw
+        behind = true;  // a box around the camera or behind it: no outline to draw
         break;
       }
       near = std::min(near, depth);
-      const float x = cx + sx * v.x / depth, y = cy + sy * v.y / depth;
-      x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+      corners[c] = glm::vec2(cx + sx * v.x / depth, cy + sy * v.y / depth);
     }
     if (behind) continue;
-    // The texels wholly inside the rectangle: its edge is the composite's per-pixel test.
-    const int ix0 = std::max(0, static_cast<int>(std::ceil(x0)));
-    const int iy0 = std::max(0, static_cast<int>(std::ceil(y0)));
-    const int ix1 = std::min(width_, static_cast<int>(std::floor(x1)));
-    const int iy1 = std::min(height_, static_cast<int>(std::floor(y1)));
-    if (ix0 >= ix1 || iy0 >= iy1) continue;
-    for (int y = iy0; y < iy1; ++y) {
+    // The box's outline: the convex hull of its corners (a box projects to a convex polygon).
+    glm::vec2 hull[16];
+    const int n = convex_hull(corners, hull);
+    float y_lo = hull[0].y, y_hi = hull[0].y;
+    for (int k = 1; k < n; ++k) y_lo = std::min(y_lo, hull[k].y), y_hi = std::max(y_hi, hull[k].y);
+    // Each row whose texel centres it spans, the texels whose centres lie inside it.
+    const int iy0 = std::max(0, static_cast<int>(std::ceil(y_lo - 0.5f)));
+    const int iy1 = std::min(height_ - 1, static_cast<int>(std::floor(y_hi - 0.5f)));
+    for (int y = iy0; y <= iy1; ++y) {
+      const float yc = y + 0.5f;
+      float x_lo = 1e9f, x_hi = -1e9f;
+      for (int k = 0; k < n; ++k) {
+        const glm::vec2 a = hull[k], e = hull[(k + 1) % n];
+        if ((a.y <= yc) == (e.y <= yc)) continue;  // the edge does not cross this row
+        const float x = a.x + (yc - a.y) * (e.x - a.x) / (e.y - a.y);
+        x_lo = std::min(x_lo, x), x_hi = std::max(x_hi, x);
+      }
+      const int ix0 = std::max(0, static_cast<int>(std::ceil(std::max(x_lo, -1.0f) - 0.5f)));
+      const int ix1 =
+          std::min(width_ - 1, static_cast<int>(std::floor(std::min(x_hi, 1e7f) - 0.5f)));
+      if (ix0 > ix1) continue;
       float* row = &occluder_depth_[static_cast<std::size_t>(y) * width_];
-      for (int x = ix0; x < ix1; ++x) row[x] = std::min(row[x], near);
+      for (int x = ix0; x <= ix1; ++x) row[x] = std::min(row[x], near);
+      const Bounds span{ix0, y, ix1 + 1, y + 1};
+      occluded_ = occluded_.empty()
+                      ? span
+                      : Bounds{std::min(occluded_.x0, span.x0), std::min(occluded_.y0, span.y0),
+                               std::max(occluded_.x1, span.x1), std::max(occluded_.y1, span.y1)};
     }
-    occluded_ = occluded_.empty()
-                    ? Bounds{ix0, iy0, ix1, iy1}
-                    : Bounds{std::min(occluded_.x0, ix0), std::min(occluded_.y0, iy0),
-                             std::max(occluded_.x1, ix1), std::max(occluded_.y1, iy1)};
   }
   return occluded_.empty() ? nullptr : occluder_depth_.data();
 }
@@ -473,26 +533,46 @@ RainLayer::Bounds RainLayer::draw_splashes(const sim::RainState& rain, const Rai
   const glm::mat4 car_view(glm::dmat4(in.view) * in.vehicle_to_world);
   int lo_x = width_, lo_y = height_, hi_x = 0, hi_y = 0;
   // One point's light, shared by the four texels around it.
-  auto splat = [&](const glm::vec3& v, float alpha) {
+  auto point = [&](const glm::vec3& v, float alpha, bool occludable) {
     const float depth = -v.z;
     if (depth < kNearestSplashM) return;
     const float x = cx + sx * v.x / depth - 0.5f, y = cy + sy * v.y / depth - 0.5f;
     if (!(x >= 0.0f && y >= 0.0f && x < width_ - 1.0f && y < height_ - 1.0f)) return;
     const int ix = static_cast<int>(x), iy = static_cast<int>(y);
     const float fx = x - ix, fy = y - iy;
-    // A little nearer than the surface it stands on, so that the depth test keeps it over it.
-    const float biased = depth * 0.96f - 0.05f;
     const std::size_t at = static_cast<std::size_t>(iy) * width_ + ix;
     const float w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
     const std::size_t texel[4] = {at, at + 1, at + width_, at + width_ + 1};
     for (int k = 0; k < 4; ++k) {
-      if (!occluded_.empty() && biased > occluder_depth_[texel[k]]) continue;
+      if (occludable && !occluded_.empty() && depth > occluder_depth_[texel[k]]) continue;
       texels_[texel[k]].alpha += alpha * w[k];
-      texels_[texel[k]].depth = std::min(texels_[texel[k]].depth, biased);
+      texels_[texel[k]].depth = std::min(texels_[texel[k]].depth, depth);
     }
     lo_x = std::min(lo_x, ix), hi_x = std::max(hi_x, ix + 2);
     lo_y = std::min(lo_y, iy), hi_y = std::max(hi_y, iy + 2);
   };
+  // A point that moves by `blur` (camera frame) during the exposure: a few points along its path,
+  // one a texel or so, as a streak is drawn.
+  auto splat = [&](const glm::vec3& v, const glm::vec3& blur, float alpha, bool occludable) {
+    const glm::vec3 tail = v + blur;
+    const float depth = -v.z, tail_depth = -tail.z;
+    int steps = 1;
+    if (depth > kNearestSplashM && tail_depth > kNearestSplashM) {
+      const float dx = sx * (tail.x / tail_depth - v.x / depth);
+      const float dy = sy * (tail.y / tail_depth - v.y / depth);
+      steps = std::clamp(static_cast<int>(std::max(std::abs(dx), std::abs(dy))) + 1, 1,
+                         kMaxSplashSteps);
+    }
+    for (int i = 0; i < steps; ++i) {
+      const float t = steps == 1 ? 0.0f : (i + 0.5f) / steps;
+      point(v + blur * t, alpha / steps, occludable);
+    }
+  };
+  // A splash on the road is still in the world: relative to the camera it moves back by the car's
+  // velocity, and during the exposure it was where the camera will have been. One on the car moves
+  // with it and with the camera (every view's camera rides on the car).
+  const float exposure = static_cast<float>(in.exposure_s);
+  const glm::vec3 road_blur = glm::mat3(view) * glm::vec3(in.camera_velocity) * exposure;
   const float dt = static_cast<float>(in.dt_s);
   for (const sim::SplashState& s : rain.splashes) {
     const float age = (s.age_s + dt) / static_cast<float>(sim::kSplashLifeS);
@@ -516,8 +596,9 @@ RainLayer::Bounds RainLayer::draw_splashes(const sim::RainState& rain, const Rai
     // A dot far away; a ring of points where the crown is a few texels wide.
     const float ring_texels = 6.2832f * radius * texels_per_m;
     const int points = std::clamp(static_cast<int>(ring_texels), 1, 16);
+    const glm::vec3 blur = s.on_car ? glm::vec3(0.0f) : road_blur;
     if (points < 3) {
-      splat(centre, alpha_total);
+      splat(centre, blur, alpha_total, !s.on_car);
       continue;
     }
     const glm::vec3 up(m * glm::vec4(0.0f, 0.0f, 1.0f, 0.0f));
@@ -525,8 +606,8 @@ RainLayer::Bounds RainLayer::draw_splashes(const sim::RainState& rain, const Rai
     const glm::vec3 e2(m * glm::vec4(0.0f, radius, 0.0f, 0.0f));
     for (int k = 0; k < points; ++k) {
       const float a = 6.2832f * (k + 0.5f * age) / points;
-      splat(centre + e1 * std::cos(a) + e2 * std::sin(a) + up * (0.4f * height),
-            alpha_total / points);
+      splat(centre + e1 * std::cos(a) + e2 * std::sin(a) + up * (0.4f * height), blur,
+            alpha_total / points, !s.on_car);
     }
   }
   return lo_x < hi_x ? Bounds{lo_x, lo_y, hi_x, hi_y} : Bounds{};

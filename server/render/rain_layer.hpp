@@ -3,8 +3,9 @@
 // setup whatever its size (75,000 drops: 60-90 ms); here a streak costs its projection and a few
 // texels (a Wu line), so 80,000 fit in a few milliseconds. Each texel keeps the streaks' opacity,
 // summed so that the order of the drops does not matter, and the depth of its nearest streak,
-// which sets the haze between it and the camera and which the composite tests against the scene's.
-// No GL.
+// which sets the haze between it and the camera. What hides the rain is settled here too: the cars
+// (their silhouettes on the layer, against each streak's depth); the cabin is the composite's
+// (rain_pass.hpp). No GL.
 #pragma once
 
 #include <cstdint>
@@ -40,10 +41,9 @@ struct RainLayerInputs {
   float opacity = 0.55f;
   float pixels_per_texel = 2.0f;     // the view's pixels per layer texel, across
   glm::dmat4 vehicle_to_world{1.0};  // the ego car at the frame's time, for the splashes on it
-  // The cars in the rain. A texel keeps one depth, its nearest streak's, which the composite tests
-  // against the scene; in dense rain nearly every texel over a car ahead has a streak in front of
-  // it, so the streaks behind a car are left out here, against its box on the layer (the box's
-  // screen rectangle at its nearest depth).
+  // What hides the rain behind it: the cars, and in the driver's view the bonnet. A streak is left
+  // out of the texels that its box covers on the layer (the convex outline of its corners, at its
+  // nearest depth) where the streak is further away than that.
   std::span<const RainOccluder> occluders;
 };
 
@@ -59,14 +59,17 @@ class RainLayer {
   int height() const { return height_; }
   // Premultiplied RGBA8 rows bottom-up (GL's order), display-encoded like the scene's colour.
   const std::vector<std::uint32_t>& colour() const { return colour_; }
-  // View depth (m) of the texel's nearest streak; 0 where there is none.
-  const std::vector<float>& depth() const { return depth_; }
   // The texels with rain lie in [x0, x1) x [y0, y1) (rows bottom-up); empty if none.
   struct Bounds {
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
     bool empty() const { return x1 <= x0 || y1 <= y0; }
   };
   const Bounds& bounds() const { return bounds_; }
+  // The tiles (kTile x kTile texels) with rain, and those beside an edge of one with rain on it, as
+  // runs along each row of tiles: rectangles of texels, clipped to the layer, in rows bottom-up.
+  // The composite draws only these.
+  static constexpr int kTile = 8;
+  const std::vector<Bounds>& runs() const { return runs_; }
 
   // The nearest a drop is drawn: nearer, it is far out of focus for an eye or camera looking at the
   // road, a faint blur that would be the largest streak of all.
@@ -80,7 +83,8 @@ class RainLayer {
  private:
   // What the streaks leave in a texel: one cache access per texel drawn. Every drop carries the
   // same light, so a texel needs only how much of it and the distance of its nearest streak, for
-  // the depth test and the haze between.
+  // the haze between and the occluders. (Halves of 16 bits each drew no faster: the draw is bound
+  // by its branches and conversions more than by these accesses.)
   // A texel no streak or splash has touched (whatever touches one lowers its depth).
   static constexpr float kUntouched = 1e30f;
   struct Texel {
@@ -95,14 +99,19 @@ class RainLayer {
   static constexpr int kMaxCopies = 6;
   // Drops projected together (rain_layer.cpp), in arrays the compiler vectorizes.
   static constexpr int kBatch = 256;
+  // The most points a splash's point is drawn as along its motion in the exposure.
+  static constexpr int kMaxSplashSteps = 6;
   // Below this many drops one thread draws them all.
   static constexpr std::size_t kDropsForTwoThreads = 4096;
 
-  // Splats the splashes' crowns into texels_, after the streaks; returns the texels touched.
+  // Splats the splashes' crowns into texels_, after the streaks, each point along its motion
+  // relative to the camera during the exposure; returns the texels touched. Those on the car
+  // itself are never behind an occluder (its bonnet is one, in the driver's view).
   Bounds draw_splashes(const sim::RainState& rain, const RainLayerInputs& in, const glm::mat4& view,
                        float sx, float sy, float cx, float cy);
 
-  // The occluders' nearest depth per texel (kUntouched where none), over occluded_ only.
+  // The occluders' nearest depth per texel (kUntouched where none), over occluded_ only: the texels
+  // whose centres lie inside the outline of an occluder's corners.
   const float* occlude(const RainLayerInputs& in, float sx, float sy, float cx, float cy);
 
   int width_ = 0, height_ = 0;
@@ -115,8 +124,18 @@ class RainLayer {
   std::vector<Texel> texels_;
   std::vector<Texel> second_;  // the second thread's
   std::vector<std::uint32_t> colour_;
-  std::vector<float> depth_;
   Bounds bounds_;
+  // Per tile: whether a texel has rain, and which of its edges (cleared once the runs are made).
+  enum : std::uint8_t {
+    kTileLit = 1,
+    kTileLeft = 2,
+    kTileRight = 4,
+    kTileBottom = 8,
+    kTileTop = 16,
+  };
+  int tiles_x_ = 0;
+  std::vector<std::uint8_t> tile_lit_;
+  std::vector<Bounds> runs_;
 };
 
 }  // namespace downpour::render

@@ -22,8 +22,7 @@ namespace downpour::render {
   X(kGlassLayer, 7, sampler2D, glass_layer_tex,                                                  \
     "the water on the glass over the scene, reduced size, premultiplied")                        \
   X(kRainLayer, 8, sampler2D, rain_layer_tex,                                                    \
-    "the rain streaks, reduced size, premultiplied (rain_layer.hpp)")                            \
-  X(kRainDepth, 9, sampler2D, rain_depth_tex, "the rain layer's nearest streak depth (m), 0 none")
+    "the rain streaks, reduced size, premultiplied (rain_layer.hpp)")
 
 // The per-frame uniform block: X(GLSL type, name, comment). Every field is a vec4 or a mat4, so
 // the C++ struct below has the std140 layout as it is.

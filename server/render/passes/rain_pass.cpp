@@ -13,18 +13,26 @@ namespace downpour::render {
 
 RainPass::RainPass(SharedResources& shared)
     : shared_(shared),
-      program_("fullscreen.vert", "rain.frag"),
-      u_near_(program_.uniform("u_near")) {}
+      program_("rain.vert", "rain.frag"),
+      u_plane_depth_(program_.uniform("u_plane_depth")) {
+  GLuint ids[kTextures + 1];
+  glCreateBuffers(kTextures, ids);
+  for (int i = 0; i < kTextures; ++i) runs_buffer_[i] = Buffer(ids[i]);
+  glCreateVertexArrays(1, &ids[kTextures]);
+  vao_ = VertexArray(ids[kTextures]);
+}
 
 bool RainPass::wanted(const FrameContext& frame) const {
   // The inputs say whether it rains; only then wait for the step's drops.
   return frame.scene.weather.rain_rate_mm_h > 0.0 && !frame.rain().drops.empty();
 }
 
-void RainPass::execute(const FrameContext& frame, const FrameResources&) {
-  const sim::RainState& rain = frame.rain();
-  const int width = (frame.spec.width + kLayerDivisor - 1) / kLayerDivisor;
-  const int height = (frame.spec.height + kLayerDivisor - 1) / kLayerDivisor;
+bool is_driver_view(sim::View view) {
+  return view == sim::View::kCockpit || view == sim::View::kRain;
+}
+
+RainLayerInputs rain_layer_inputs(const FrameContext& frame, int layer_height,
+                                  std::vector<RainOccluder>& occluders) {
   RainLayerInputs in;
   in.view = frame.camera.view;
   in.tan_half_fov_x = frame.camera.tan_half_fov_x;
@@ -32,16 +40,17 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
   in.camera_velocity = frame.scene.vehicle.velocity_mps;
   in.vehicle_to_world = sim::vehicle_to_world(frame.scene.vehicle);
   // The cars in the rain hide what falls behind them: each as its hull and its cabin, the shape
-  // VehiclePass draws (scaled to a traffic car's size); the ego car too, seen from outside.
+  // VehiclePass draws (scaled to a traffic car's size).
   namespace body = sim::car_body;
-  occluders_.clear();  // kept from frame to frame: no allocation once it has grown
+  occluders.clear();  // kept from frame to frame: no allocation once it has grown
+  const float hull_top = static_cast<float>(body::kHullTopZ);
   auto add_car = [&](const glm::dmat4& to_world) {
-    occluders_.push_back({to_world, glm::vec3(-0.95f, -0.9f, 0.28f),
-                          glm::vec3(3.65f, 0.9f, static_cast<float>(body::kHullTopZ))});
-    occluders_.push_back(
+    occluders.push_back(
+        {to_world, glm::vec3(-0.95f, -0.9f, 0.28f), glm::vec3(3.65f, 0.9f, hull_top)});
+    occluders.push_back(
         {to_world,
          glm::vec3(static_cast<float>(body::kCabinRearX),
-                   -static_cast<float>(body::kCabinHalfWidth), static_cast<float>(body::kHullTopZ)),
+                   -static_cast<float>(body::kCabinHalfWidth), hull_top),
          glm::vec3(static_cast<float>(body::kCabinFrontX),
                    static_cast<float>(body::kCabinHalfWidth), static_cast<float>(body::kRoofZ))});
   };
@@ -49,9 +58,17 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
     const glm::dvec3 scale(other.size_m.x / 4.6, other.size_m.y / 1.8, other.size_m.z / 1.47);
     add_car(glm::scale(sim::vehicle_to_world(other.state), scale));
   }
-  if (frame.spec.view == sim::View::kRoad) add_car(in.vehicle_to_world);
-  in.occluders = occluders_;
-  in.dt_s = frame.scene.sim_time_s - rain.time_s;
+  // The driver sees the rain over the road ahead, not over the bonnet: its box from the glass's
+  // foot forward. Seen from outside, the whole ego car.
+  if (is_driver_view(frame.spec.view)) {
+    occluders.push_back({in.vehicle_to_world,
+                         glm::vec3(static_cast<float>(body::kCabinFrontX), -0.9f, 0.28f),
+                         glm::vec3(3.65f, 0.9f, hull_top)});
+  } else {
+    add_car(in.vehicle_to_world);
+  }
+  in.occluders = occluders;
+  in.dt_s = frame.scene.sim_time_s - frame.rain().time_s;
   in.exposure_s = frame.spec.exposure_s.value_or(in.exposure_s);  // else the layer's default
   // A drop refracts a wide cone of what is around it: it carries the sky's and the scene's light
   // (not white paint), dimmed a little, and the haze between it and the camera.
@@ -59,45 +76,60 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
   in.light = glm::mix(atm.sky_horizon, atm.ambient, 0.4f) * 0.95f + atm.sun_radiance * 0.05f;
   in.haze = atm.fog_colour;
   in.haze_per_m = atm.fog_density;
-  in.pixels_per_texel = static_cast<float>(frame.spec.height) / static_cast<float>(height);
+  in.pixels_per_texel = static_cast<float>(frame.spec.height) / static_cast<float>(layer_height);
+  return in;
+}
+
+void RainPass::execute(const FrameContext& frame, const FrameResources&) {
+  const sim::RainState& rain = frame.rain();
+  const int width = (frame.spec.width + kLayerDivisor - 1) / kLayerDivisor;
+  const int height = (frame.spec.height + kLayerDivisor - 1) / kLayerDivisor;
+  const RainLayerInputs in = rain_layer_inputs(frame, height, occluders_);
   const auto t0 = std::chrono::steady_clock::now();
   drawn_.streaks = layer_.build(rain, in, width, height);
   drawn_.layer_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
   if (width != texture_width_ || height != texture_height_) {
-    for (int i = 0; i < kTexturePairs; ++i) {
-      colour_[i] = make_texture_2d(GL_RGBA8, width, height);
-      depth_[i] = make_texture_2d(GL_R32F, width, height);
-      glTextureParameteri(colour_[i].id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      glTextureParameteri(colour_[i].id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-      glTextureParameteri(colour_[i].id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-      glTextureParameteri(colour_[i].id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-      glTextureParameteri(depth_[i].id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      glTextureParameteri(depth_[i].id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    for (Texture& texture : colour_) {
+      texture = make_texture_2d(GL_RGBA8, width, height);
+      glTextureParameteri(texture.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTextureParameteri(texture.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTextureParameteri(texture.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTextureParameteri(texture.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     }
     texture_width_ = width;
     texture_height_ = height;
   }
-  const int pair = next_pair_;
-  next_pair_ = (next_pair_ + 1) % kTexturePairs;
+  const Texture& texture = colour_[next_texture_];
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  glTextureSubImage2D(colour_[pair].id(), 0, 0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE,
+  glTextureSubImage2D(texture.id(), 0, 0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE,
                       layer_.colour().data());
-  glTextureSubImage2D(depth_[pair].id(), 0, 0, 0, width, height, GL_RED, GL_FLOAT,
-                      layer_.depth().data());
-  glBindTextureUnit(texture_unit::kRainLayer, colour_[pair].id());
-  glBindTextureUnit(texture_unit::kRainDepth, depth_[pair].id());
-  const RainLayer::Bounds& b = layer_.bounds();
-  if (b.empty()) return;
+  glBindTextureUnit(texture_unit::kRainLayer, texture.id());
+  const std::vector<RainLayer::Bounds>& runs = layer_.runs();
+  if (runs.empty()) return;
+  // Only the tiles with rain: on llvmpipe the composite's cost is the area it covers, lit or not.
+  runs_uv_.clear();
+  const glm::vec2 texel(1.0f / width, 1.0f / height);
+  for (const RainLayer::Bounds& r : runs)
+    runs_uv_.emplace_back(r.x0 * texel.x, r.y0 * texel.y, r.x1 * texel.x, r.y1 * texel.y);
+  // A buffer of its own for each frame in turn (made anew each time, as the textures are taken in
+  // turn), so that the upload never waits for the draw before.
+  const Buffer& buffer = runs_buffer_[next_texture_];
+  glNamedBufferData(buffer.id(), static_cast<GLsizeiptr>(runs_uv_.size() * sizeof(glm::vec4)),
+                    runs_uv_.data(), GL_STREAM_DRAW);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buffer.id());
+  next_texture_ = (next_texture_ + 1) % kTextures;
   program_.use();
-  u_near_.set(frame.camera.near_m);
-  // Only where the layer has rain: the composite's fragments are most of its cost on llvmpipe.
-  glEnable(GL_SCISSOR_TEST);
-  glScissor(b.x0 * kLayerDivisor - 1, b.y0 * kLayerDivisor - 1, (b.x1 - b.x0) * kLayerDivisor + 2,
-            (b.y1 - b.y0) * kLayerDivisor + 2);
-  shared_.fullscreen.draw();
-  glDisable(GL_SCISSOR_TEST);
+  // The driver's views: the rain at the windshield's depth, so that the depth test leaves out the
+  // cabin (nearer than the glass). Other cameras have no cabin: a plane nearer than any drop.
+  u_plane_depth_.set(is_driver_view(frame.spec.view)
+                         ? frame.glass.depth_over_image()
+                         : glm::vec3(0.0f, 0.0f, frame.camera.near_m / RainLayer::kNearestSplashM));
+  glEnable(GL_DEPTH_CLAMP);
+  glBindVertexArray(vao_.id());
+  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(6 * runs_uv_.size()));
+  glDisable(GL_DEPTH_CLAMP);
 }
 
 void RainMaskPass::execute(const FrameContext&, const FrameResources& resources) {

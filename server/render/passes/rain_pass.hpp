@@ -3,6 +3,9 @@
 #include <utility>
 #include <vector>
 
+#include <glm/vec4.hpp>
+
+#include "server/render/gl_objects.hpp"
 #include "server/render/pass.hpp"
 #include "server/render/rain_layer.hpp"
 
@@ -10,9 +13,21 @@ namespace downpour::render {
 
 // Rain in the air (seed 004): the simulation's drops near the car as streaks, their motion relative
 // to the camera during the exposure, in the light around them and faded with distance. They are
-// drawn on the CPU into a layer of half the view's size (rain_layer.hpp), which this pass
-// composites with a depth test: none inside the cabin, none in front of a nearer car. In COCKPIT it
-// runs before the glass passes, so the water on the glass refracts the scene with the rain in it.
+// drawn on the CPU into a layer of half the view's size (rain_layer.hpp), where the cars hide what
+// falls behind them. This pass composites it over the scene at the windshield's depth, so that the
+// depth test leaves the cabin dry: one texture fetch and no depth per pixel (a depth per texel,
+// tested per pixel, was two fetches and a depth written per pixel: 60% more for the pass on
+// llvmpipe). In COCKPIT it runs before the glass passes, so the water on the glass refracts the
+// scene with the rain in it.
+// Whether a view looks from the driver's seat (COCKPIT and RAIN): through the windshield, over the
+// bonnet.
+bool is_driver_view(sim::View view);
+
+// What the rain layer needs of a frame: the camera, the light and haze, the exposure, and what
+// hides the rain (the cars' boxes, kept in `occluders`, which the inputs refer to).
+RainLayerInputs rain_layer_inputs(const FrameContext& frame, int layer_height,
+                                  std::vector<RainOccluder>& occluders);
+
 class RainPass final : public Pass {
  public:
   explicit RainPass(SharedResources& shared);
@@ -37,20 +52,23 @@ class RainPass final : public Pass {
                        true};
   SharedResources& shared_;
   ShaderProgram program_;
-  Uniform u_near_;
+  Uniform u_plane_depth_;
   RainLayer layer_;
   std::vector<RainOccluder> occluders_;  // this frame's cars, for the layer
-  // A few pairs of layer textures in turn, so that an upload never waits for the GPU to finish
-  // drawing with the pair before.
-  static constexpr int kTexturePairs = 3;
-  Texture colour_[kTexturePairs], depth_[kTexturePairs];
-  int next_pair_ = 0;
+  // A few layer textures in turn, so that an upload never waits for the GPU to finish drawing with
+  // the one before.
+  static constexpr int kTextures = 3;
+  Texture colour_[kTextures];
+  Buffer runs_buffer_[kTextures];  // the runs of tiles to draw, uv over the view (rain.vert)
+  std::vector<glm::vec4> runs_uv_;
+  VertexArray vao_;  // none of its own attributes: rain.vert reads the runs
+  int next_texture_ = 0;
   int texture_width_ = 0, texture_height_ = 0;
   Drawn drawn_;
 };
 
 // RAIN view: the rain layer alone over black. The scene's passes before it leave their depth, so
-// that the rain is hidden where the scene is nearer; this clears their colour.
+// that the rain is left off the cabin; this clears their colour.
 class RainMaskPass final : public Pass {
  public:
   explicit RainMaskPass(SharedResources&) {}

@@ -1,0 +1,92 @@
+// The rain layer on the CPU (no GL): a box hides the streaks behind it and not those in front of
+// it, on the texels inside its outline; the composite's runs of tiles cover every texel with rain
+// and, for rain in one part of the view, little else.
+#include "server/render/rain_layer.hpp"
+
+#include <gtest/gtest.h>
+#include <glm/ext/matrix_transform.hpp>
+
+namespace downpour::render {
+namespace {
+
+constexpr int kWidth = 160;
+constexpr int kHeight = 90;
+
+// A camera at the world's origin looking along +x (z up), 60 degrees high, and a box of rain
+// around it with no fall speed to speak of (dots, not streaks).
+RainLayerInputs inputs() {
+  RainLayerInputs in;
+  in.view = glm::lookAt(glm::vec3(0.0f), glm::vec3(1.0f, 0.0f, 0.0f), glm::vec3(0.0f, 0.0f, 1.0f));
+  in.tan_half_fov_y = std::tan(glm::radians(30.0));
+  in.tan_half_fov_x = in.tan_half_fov_y * kWidth / kHeight;
+  in.exposure_s = 0.0;
+  in.light = glm::vec3(0.6f);
+  in.haze = glm::vec3(0.5f);
+  in.pixels_per_texel = 2.0f;
+  return in;
+}
+
+sim::RainState rain_at(const std::vector<glm::vec3>& positions) {
+  sim::RainState rain;
+  rain.box_half_m = glm::vec3(40.0f, 40.0f, 10.0f);
+  for (const glm::vec3& p : positions) rain.drops.emplace_back(p, 3.0f);
+  return rain;
+}
+
+// A column of drops at distance x, straight ahead, from z = -0.6 to 0.6 m.
+std::vector<glm::vec3> column(float x) {
+  std::vector<glm::vec3> out;
+  for (int i = 0; i <= 24; ++i) out.emplace_back(x, 0.0f, -0.6f + 0.05f * i);
+  return out;
+}
+
+std::uint32_t alpha_at_centre(const RainLayer& layer) {
+  return layer.colour()[static_cast<std::size_t>(kHeight / 2) * kWidth + kWidth / 2] >> 24;
+}
+
+TEST(RainLayerTest, ABoxHidesTheDropsBehindItAndNotThoseInFront) {
+  // A box 1 m either side of the view's centre line, 8 to 9 m ahead.
+  const RainOccluder box{glm::dmat4(1.0), glm::vec3(8.0f, -1.0f, -1.0f),
+                         glm::vec3(9.0f, 1.0f, 1.0f)};
+  RainLayerInputs in = inputs();
+  RainLayer layer;
+  for (const float x : {4.0f, 20.0f}) {
+    SCOPED_TRACE(x);
+    layer.build(rain_at(column(x)), in, kWidth, kHeight);
+    EXPECT_GT(alpha_at_centre(layer), 0u) << "no box: the drops show";
+    in.occluders = std::span<const RainOccluder>(&box, 1);
+    layer.build(rain_at(column(x)), in, kWidth, kHeight);
+    if (x < 8.0f) {
+      EXPECT_GT(alpha_at_centre(layer), 0u) << "in front of the box";
+    } else {
+      EXPECT_EQ(alpha_at_centre(layer), 0u) << "behind the box";
+    }
+    in.occluders = {};
+  }
+}
+
+TEST(RainLayerTest, TheRunsCoverEveryTexelWithRainAndLittleElse) {
+  // Drops in the upper right part of the view only, 10 m ahead.
+  std::vector<glm::vec3> drops;
+  for (int i = 0; i < 200; ++i)
+    drops.emplace_back(10.0f, -2.0f - 0.02f * i, 1.5f + 0.01f * (i % 50));
+  RainLayer layer;
+  layer.build(rain_at(drops), inputs(), kWidth, kHeight);
+  int lit = 0, covered = 0;
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      bool in_run = false;
+      for (const RainLayer::Bounds& r : layer.runs())
+        in_run = in_run || (x >= r.x0 && x < r.x1 && y >= r.y0 && y < r.y1);
+      covered += in_run;
+      if (layer.colour()[static_cast<std::size_t>(y) * kWidth + x] == 0u) continue;
+      ++lit;
+      EXPECT_TRUE(in_run) << x << "," << y;
+    }
+  }
+  EXPECT_GT(lit, 20);
+  EXPECT_LT(covered, kWidth * kHeight / 4) << "runs over a corner of rain, not the view";
+}
+
+}  // namespace
+}  // namespace downpour::render
