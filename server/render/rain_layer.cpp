@@ -445,7 +445,9 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
                ? 0
                : tile_lit_[static_cast<std::size_t>(ty) * tiles_x_ + tx];
   };
+  const bool any_hidden = in.hidden_tiles.size() == tile_lit_.size();
   auto drawn_tile = [&](int tx, int ty) {
+    if (any_hidden && in.hidden_tiles[static_cast<std::size_t>(ty) * tiles_x_ + tx]) return false;
     return (at(tx, ty) & kTileLit) || (at(tx - 1, ty) & kTileRight) ||
            (at(tx + 1, ty) & kTileLeft) || (at(tx, ty - 1) & kTileTop) ||
            (at(tx, ty + 1) & kTileBottom);

@@ -45,6 +45,9 @@ struct RainLayerInputs {
   // out of the texels that its box covers on the layer (the convex outline of its corners, at its
   // nearest depth) where the streak is further away than that.
   std::span<const RainOccluder> occluders;
+  // Per tile of RainLayer::kTile texels (rows bottom-up), 1 where the cabin hides all of it
+  // (cabin_tiles.hpp): the runs leave those out. Empty: none.
+  std::span<const std::uint8_t> hidden_tiles;
 };
 
 class RainLayer {
@@ -65,9 +68,10 @@ class RainLayer {
     bool empty() const { return x1 <= x0 || y1 <= y0; }
   };
   const Bounds& bounds() const { return bounds_; }
-  // The tiles (kTile x kTile texels) with rain, and those beside an edge of one with rain on it, as
-  // runs along each row of tiles: rectangles of texels, clipped to the layer, in rows bottom-up.
-  // The composite draws only these.
+  // The tiles (kTile x kTile texels) with rain, and those beside an edge of one with rain on it,
+  // but for those the cabin hides (RainLayerInputs::hidden_tiles), as runs along each row of
+  // tiles: rectangles of texels, clipped to the layer, in rows bottom-up. The composite draws only
+  // these.
   static constexpr int kTile = 8;
   const std::vector<Bounds>& runs() const { return runs_; }
 

@@ -5,7 +5,9 @@
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "server/render/cabin_tiles.hpp"
 #include "server/render/shader_interface.hpp"
+#include "server/render/vehicle_geometry.hpp"
 #include "server/sim/car_body.hpp"
 #include "server/sim/pose.hpp"
 
@@ -84,7 +86,8 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
   const sim::RainState& rain = frame.rain();
   const int width = (frame.spec.width + kLayerDivisor - 1) / kLayerDivisor;
   const int height = (frame.spec.height + kLayerDivisor - 1) / kLayerDivisor;
-  const RainLayerInputs in = rain_layer_inputs(frame, height, occluders_);
+  RainLayerInputs in = rain_layer_inputs(frame, height, occluders_);
+  if (is_driver_view(frame.spec.view)) in.hidden_tiles = cabin_tiles_for(frame, width, height);
   const auto t0 = std::chrono::steady_clock::now();
   drawn_.streaks = layer_.build(rain, in, width, height);
   drawn_.layer_ms =
@@ -130,6 +133,27 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
   glBindVertexArray(vao_.id());
   glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(6 * runs_uv_.size()));
   glDisable(GL_DEPTH_CLAMP);
+}
+
+const std::vector<std::uint8_t>& RainPass::cabin_tiles_for(const FrameContext& frame, int width,
+                                                           int height) {
+  const Camera& c = frame.camera;
+  const sim::GlassConfig& g = frame.scene.glass;
+  for (const CabinTiles& t : cabin_tiles_) {
+    if (t.width == width && t.height == height && t.eye == c.position_vehicle &&
+        t.axes == c.axes_vehicle && t.tan_x == c.tan_half_fov_x && t.tan_y == c.tan_half_fov_y &&
+        t.glass.bottom_left_m == g.bottom_left_m && t.glass.bottom_width_mm == g.bottom_width_mm &&
+        t.glass.top_width_mm == g.top_width_mm && t.glass.height_mm == g.height_mm &&
+        t.glass.rake_deg == g.rake_deg)
+      return t.hidden;
+  }
+  // A few cameras at once (the sessions' views); the oldest goes.
+  constexpr std::size_t kKept = 8;
+  if (cabin_tiles_.size() >= kKept) cabin_tiles_.erase(cabin_tiles_.begin());
+  cabin_tiles_.push_back(
+      {width, height, c.position_vehicle, c.axes_vehicle, c.tan_half_fov_x, c.tan_half_fov_y, g,
+       cabin_tiles(build_cockpit_interior(g), c, width, height, RainLayer::kTile)});
+  return cabin_tiles_.back().hidden;
 }
 
 void RainMaskPass::execute(const FrameContext&, const FrameResources& resources) {

@@ -11,14 +11,6 @@
 
 namespace downpour::render {
 
-// Rain in the air (seed 004): the simulation's drops near the car as streaks, their motion relative
-// to the camera during the exposure, in the light around them and faded with distance. They are
-// drawn on the CPU into a layer of half the view's size (rain_layer.hpp), where the cars hide what
-// falls behind them. This pass composites it over the scene at the windshield's depth, so that the
-// depth test leaves the cabin dry: one texture fetch and no depth per pixel (a depth per texel,
-// tested per pixel, was two fetches and a depth written per pixel: 60% more for the pass on
-// llvmpipe). In COCKPIT it runs before the glass passes, so the water on the glass refracts the
-// scene with the rain in it.
 // Whether a view looks from the driver's seat (COCKPIT and RAIN): through the windshield, over the
 // bonnet.
 bool is_driver_view(sim::View view);
@@ -28,6 +20,16 @@ bool is_driver_view(sim::View view);
 RainLayerInputs rain_layer_inputs(const FrameContext& frame, int layer_height,
                                   std::vector<RainOccluder>& occluders);
 
+// Rain in the air (seed 004): the simulation's drops near the car as streaks, their motion relative
+// to the camera during the exposure, in the light around them and faded with distance. They are
+// drawn on the CPU into a layer of half the view's size (rain_layer.hpp), where the cars hide what
+// falls behind them. This pass composites it over the scene at the windshield's depth, so that the
+// depth test leaves the cabin dry: one texture fetch and no depth per pixel (a depth per texel,
+// tested per pixel, took a second fetch and a depth written per pixel, and made the 10,000-streak
+// pass about 30% dearer on llvmpipe). It draws only the layer's tiles with rain, and not those the
+// cabin hides wholly (cabin_tiles.hpp): a fragment the depth test rejects still costs. In COCKPIT
+// it runs before the glass passes, so the water on the glass refracts the scene with the rain in
+// it.
 class RainPass final : public Pass {
  public:
   explicit RainPass(SharedResources& shared);
@@ -55,6 +57,18 @@ class RainPass final : public Pass {
   Uniform u_plane_depth_;
   RainLayer layer_;
   std::vector<RainOccluder> occluders_;  // this frame's cars, for the layer
+  // The layer's tiles that the cabin hides, per driver's camera (cabin_tiles.hpp), the latest few.
+  struct CabinTiles {
+    int width = 0, height = 0;
+    glm::dvec3 eye{0.0};
+    glm::dmat3 axes{1.0};
+    double tan_x = 0.0, tan_y = 0.0;
+    sim::GlassConfig glass;  // the cabin is built around it
+    std::vector<std::uint8_t> hidden;
+  };
+  const std::vector<std::uint8_t>& cabin_tiles_for(const FrameContext& frame, int width,
+                                                   int height);
+  std::vector<CabinTiles> cabin_tiles_;
   // A few layer textures in turn, so that an upload never waits for the GPU to finish drawing with
   // the one before.
   static constexpr int kTextures = 3;
