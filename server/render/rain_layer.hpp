@@ -62,12 +62,11 @@ class RainLayer {
   int height() const { return height_; }
   // Premultiplied RGBA8 rows bottom-up (GL's order), display-encoded like the scene's colour.
   const std::vector<std::uint32_t>& colour() const { return colour_; }
-  // The texels with rain lie in [x0, x1) x [y0, y1) (rows bottom-up); empty if none.
+  // A rectangle of texels, [x0, x1) x [y0, y1) (rows bottom-up); empty if none.
   struct Bounds {
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
     bool empty() const { return x1 <= x0 || y1 <= y0; }
   };
-  const Bounds& bounds() const { return bounds_; }
   // The tiles (kTile x kTile texels) with rain, and those beside an edge of one with rain on it,
   // but for those the cabin hides (RainLayerInputs::hidden_tiles), as runs along each row of
   // tiles: rectangles of texels, clipped to the layer, in rows bottom-up. The composite draws only
@@ -128,7 +127,7 @@ class RainLayer {
   std::vector<Texel> texels_;
   std::vector<Texel> second_;  // the second thread's
   std::vector<std::uint32_t> colour_;
-  Bounds bounds_;
+  Bounds bounds_;  // the texels the last build wrote to colour_, cleared by the next
   // Per tile: whether a texel has rain, and which of its edges (cleared once the runs are made).
   enum : std::uint8_t {
     kTileLit = 1,

@@ -51,6 +51,11 @@ WindshieldCorners windshield_corners(const sim::GlassConfig& glass) {
           glm::vec3(glass.to_vehicle({glass.bottom_width_mm - inset, glass.height_mm}))};
 }
 
+bool same_cockpit_interior(const sim::GlassConfig& a, const sim::GlassConfig& b) {
+  return a.bottom_left_m == b.bottom_left_m && a.bottom_width_mm == b.bottom_width_mm &&
+         a.top_width_mm == b.top_width_mm && a.height_mm == b.height_mm && a.rake_deg == b.rake_deg;
+}
+
 MeshData build_cockpit_interior(const sim::GlassConfig& glass) {
   const WindshieldCorners g = windshield_corners(glass);
   MeshData m;

@@ -35,5 +35,7 @@ MeshData build_car_hull();
 MeshData build_car_upper();
 // Dashboard, A-pillars, roof edge and mirror as seen from the driver's seat.
 MeshData build_cockpit_interior(const sim::GlassConfig& glass);
+// Whether two glasses give the same cockpit interior (the fields it is built from).
+bool same_cockpit_interior(const sim::GlassConfig& a, const sim::GlassConfig& b);
 
 }  // namespace downpour::render

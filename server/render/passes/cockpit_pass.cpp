@@ -12,10 +12,7 @@ CockpitPass::CockpitPass(SharedResources&)
 void CockpitPass::execute(const FrameContext& frame, const FrameResources&) {
   // The cabin is built around the scene's glass (remade in the rare case that it changes).
   const sim::GlassConfig& glass = frame.scene.glass;
-  if (glass.bottom_left_m != built_for_.bottom_left_m ||
-      glass.bottom_width_mm != built_for_.bottom_width_mm ||
-      glass.top_width_mm != built_for_.top_width_mm || glass.height_mm != built_for_.height_mm ||
-      glass.rake_deg != built_for_.rake_deg) {
+  if (!same_cockpit_interior(glass, built_for_)) {
     built_for_ = glass;
     interior_ = Mesh(build_cockpit_interior(built_for_));
   }

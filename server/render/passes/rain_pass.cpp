@@ -17,11 +17,9 @@ RainPass::RainPass(SharedResources& shared)
     : shared_(shared),
       program_("rain.vert", "rain.frag"),
       u_plane_depth_(program_.uniform("u_plane_depth")) {
-  GLuint ids[kTextures + 1];
-  glCreateBuffers(kTextures, ids);
-  for (int i = 0; i < kTextures; ++i) runs_buffer_[i] = Buffer(ids[i]);
-  glCreateVertexArrays(1, &ids[kTextures]);
-  vao_ = VertexArray(ids[kTextures]);
+  GLuint vao = 0;
+  glCreateVertexArrays(1, &vao);
+  vao_ = VertexArray(vao);
 }
 
 bool RainPass::wanted(const FrameContext& frame) const {
@@ -101,6 +99,16 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
       glTextureParameteri(texture.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
       glTextureParameteri(texture.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     }
+    // Room for a run per tile, the most there can be (each covers a tile at least).
+    const GLsizeiptr capacity = static_cast<GLsizeiptr>(sizeof(glm::vec4)) *
+                                ((width + RainLayer::kTile - 1) / RainLayer::kTile) *
+                                ((height + RainLayer::kTile - 1) / RainLayer::kTile);
+    for (Buffer& buffer : runs_buffer_) {
+      GLuint id = 0;
+      glCreateBuffers(1, &id);
+      glNamedBufferStorage(id, capacity, nullptr, GL_DYNAMIC_STORAGE_BIT);
+      buffer = Buffer(id);
+    }
     texture_width_ = width;
     texture_height_ = height;
   }
@@ -116,11 +124,11 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
   const glm::vec2 texel(1.0f / width, 1.0f / height);
   for (const RainLayer::Bounds& r : runs)
     runs_uv_.emplace_back(r.x0 * texel.x, r.y0 * texel.y, r.x1 * texel.x, r.y1 * texel.y);
-  // A buffer of its own for each frame in turn (made anew each time, as the textures are taken in
-  // turn), so that the upload never waits for the draw before.
+  // A buffer for each frame in turn, as the textures, so that the upload never waits for the draw
+  // before.
   const Buffer& buffer = runs_buffer_[next_texture_];
-  glNamedBufferData(buffer.id(), static_cast<GLsizeiptr>(runs_uv_.size() * sizeof(glm::vec4)),
-                    runs_uv_.data(), GL_STREAM_DRAW);
+  glNamedBufferSubData(buffer.id(), 0, static_cast<GLsizeiptr>(runs_uv_.size() * sizeof(glm::vec4)),
+                       runs_uv_.data());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buffer.id());
   next_texture_ = (next_texture_ + 1) % kTextures;
   program_.use();
@@ -142,9 +150,7 @@ const std::vector<std::uint8_t>& RainPass::cabin_tiles_for(const FrameContext& f
   for (const CabinTiles& t : cabin_tiles_) {
     if (t.width == width && t.height == height && t.eye == c.position_vehicle &&
         t.axes == c.axes_vehicle && t.tan_x == c.tan_half_fov_x && t.tan_y == c.tan_half_fov_y &&
-        t.glass.bottom_left_m == g.bottom_left_m && t.glass.bottom_width_mm == g.bottom_width_mm &&
-        t.glass.top_width_mm == g.top_width_mm && t.glass.height_mm == g.height_mm &&
-        t.glass.rake_deg == g.rake_deg)
+        same_cockpit_interior(t.glass, g))
       return t.hidden;
   }
   // Every driver's camera of the sessions at once, as a rule (a view's camera is fixed for its
