@@ -1,8 +1,9 @@
 #version 450
 // The rain layer's runs of tiles with rain (rain_layer.hpp), two triangles each, at the depth of a
-// plane over the view: in the driver's views the windshield's, so that the depth test keeps the
-// rain off what is on the driver's side of the glass (the cabin) without a depth per pixel. Drawn
-// with depth clamping, so that no part of a run is clipped where the plane leaves [0, 1].
+// plane over the view. The runs the cabin reaches into are drawn depth-tested with the plane the
+// windshield's, so that the test keeps the rain off what is on the driver's side of the glass
+// without a depth per pixel, and with depth clamping, so that no part of a run is clipped where
+// the plane leaves [0, 1]. The others are drawn without a depth test.
 layout(std430, binding = 0) readonly buffer Runs {
   vec4 runs[];  // uv over the view: x0, y0, x1, y1
 };

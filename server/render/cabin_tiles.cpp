@@ -68,14 +68,25 @@ std::vector<std::uint8_t> cabin_tiles(const MeshData& cabin, const Camera& camer
                              0.5 * height + sy * out[k].z / out[k].x);
     for (int k = 1; k + 1 < n; ++k) fill(screen[0], screen[k], screen[k + 1]);
   }
+  auto covered_at = [&](int x, int y) {
+    return covered[static_cast<std::size_t>(y) * width + x] != 0;
+  };
   for (int ty = 0; ty < tiles_y; ++ty) {
     for (int tx = 0; tx < tiles_x; ++tx) {
+      const int x0 = tx * tile, x1 = std::min((tx + 1) * tile, width);
+      const int y0 = ty * tile, y1 = std::min((ty + 1) * tile, height);
       bool all = true;
-      for (int y = ty * tile; all && y < std::min((ty + 1) * tile, height); ++y) {
-        for (int x = tx * tile; all && x < std::min((tx + 1) * tile, width); ++x)
-          all = covered[static_cast<std::size_t>(y) * width + x] != 0;
+      for (int y = y0; all && y < y1; ++y) {
+        for (int x = x0; all && x < x1; ++x) all = covered_at(x, y);
       }
-      hidden[static_cast<std::size_t>(ty) * tiles_x + tx] = all;
+      bool any = false;  // over the tile and a texel around it
+      for (int y = std::max(y0 - 1, 0); !any && y < std::min(y1 + 1, height); ++y) {
+        for (int x = std::max(x0 - 1, 0); !any && x < std::min(x1 + 1, width); ++x)
+          any = covered_at(x, y);
+      }
+      hidden[static_cast<std::size_t>(ty) * tiles_x + tx] = all   ? kCabinHidden
+                                                            : any ? kCabinEdge
+                                                                  : kCabinClear;
     }
   }
   return hidden;

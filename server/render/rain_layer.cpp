@@ -9,6 +9,8 @@
 #include <glm/geometric.hpp>
 #include <glm/matrix.hpp>
 
+#include "server/render/cabin_tiles.hpp"
+
 namespace downpour::render {
 
 namespace {
@@ -118,6 +120,7 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
   }
   bounds_ = Bounds{};
   runs_.clear();
+  clear_runs_ = 0;
   if (rain.drops.empty() || width <= 0 || height <= 0) return 0;
 
   const glm::vec3 fall = rain.fall_direction;
@@ -445,22 +448,33 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
                ? 0
                : tile_lit_[static_cast<std::size_t>(ty) * tiles_x_ + tx];
   };
-  const bool any_hidden = in.hidden_tiles.size() == tile_lit_.size();
-  auto drawn_tile = [&](int tx, int ty) {
-    if (any_hidden && in.hidden_tiles[static_cast<std::size_t>(ty) * tiles_x_ + tx]) return false;
-    return (at(tx, ty) & kTileLit) || (at(tx - 1, ty) & kTileRight) ||
-           (at(tx + 1, ty) & kTileLeft) || (at(tx, ty - 1) & kTileTop) ||
-           (at(tx, ty + 1) & kTileBottom);
+  // What each tile is to the composite: left out, drawn as it is, or drawn depth-tested (the
+  // cabin reaches into it).
+  const bool cabin = in.cabin_tiles.size() == tile_lit_.size();
+  enum Draw { kSkip, kClear, kEdge };
+  auto draw_as = [&](int tx, int ty) {
+    const std::uint8_t c = cabin ? in.cabin_tiles[static_cast<std::size_t>(ty) * tiles_x_ + tx]
+                                 : std::uint8_t{kCabinClear};
+    if (c == kCabinHidden) return kSkip;
+    const bool rain = (at(tx, ty) & kTileLit) || (at(tx - 1, ty) & kTileRight) ||
+                      (at(tx + 1, ty) & kTileLeft) || (at(tx, ty - 1) & kTileTop) ||
+                      (at(tx, ty + 1) & kTileBottom);
+    return !rain ? kSkip : c == kCabinEdge ? kEdge : kClear;
   };
+  edge_runs_.clear();
   for (int ty = ty0; ty < ty1; ++ty) {
-    for (int tx = tx0; tx < tx1; ++tx) {
-      if (!drawn_tile(tx, ty)) continue;
+    for (int tx = tx0; tx < tx1;) {
+      const Draw kind = draw_as(tx, ty);
       const int first = tx;
-      while (tx < tx1 && drawn_tile(tx, ty)) ++tx;
-      runs_.push_back({first * kTile, ty * kTile, std::min(tx * kTile, width),
-                       std::min((ty + 1) * kTile, height)});
+      while (tx < tx1 && draw_as(tx, ty) == kind) ++tx;
+      if (kind == kSkip) continue;
+      (kind == kClear ? runs_ : edge_runs_)
+          .push_back({first * kTile, ty * kTile, std::min(tx * kTile, width),
+                      std::min((ty + 1) * kTile, height)});
     }
   }
+  clear_runs_ = runs_.size();
+  runs_.insert(runs_.end(), edge_runs_.begin(), edge_runs_.end());
   for (int ty = ty0; ty < ty1; ++ty) {
     std::fill_n(tile_lit_.begin() + static_cast<std::size_t>(ty) * tiles_x_ + tx0, tx1 - tx0, 0);
   }

@@ -45,9 +45,10 @@ struct RainLayerInputs {
   // out of the texels that its box covers on the layer (the convex outline of its corners, at its
   // nearest depth) where the streak is further away than that.
   std::span<const RainOccluder> occluders;
-  // Per tile of RainLayer::kTile texels (rows bottom-up), 1 where the cabin hides all of it
-  // (cabin_tiles.hpp): the runs leave those out. Empty: none.
-  std::span<const std::uint8_t> hidden_tiles;
+  // Per tile of RainLayer::kTile texels (rows bottom-up), what the cabin does to it (CabinTile,
+  // cabin_tiles.hpp): the runs leave out the tiles it hides, and put those it reaches into apart.
+  // Empty: no cabin (every tile clear).
+  std::span<const std::uint8_t> cabin_tiles;
 };
 
 class RainLayer {
@@ -68,11 +69,13 @@ class RainLayer {
     bool empty() const { return x1 <= x0 || y1 <= y0; }
   };
   // The tiles (kTile x kTile texels) with rain, and those beside an edge of one with rain on it,
-  // but for those the cabin hides (RainLayerInputs::hidden_tiles), as runs along each row of
-  // tiles: rectangles of texels, clipped to the layer, in rows bottom-up. The composite draws only
-  // these.
+  // but for those the cabin hides (RainLayerInputs::cabin_tiles), as runs along each row of
+  // tiles: rectangles of texels, clipped to the layer. The composite draws only these. First the
+  // runs of tiles clear of the cabin (clear_runs() of them, rows bottom-up), which need no depth
+  // test, then those of the tiles that the cabin reaches into.
   static constexpr int kTile = 8;
   const std::vector<Bounds>& runs() const { return runs_; }
+  std::size_t clear_runs() const { return clear_runs_; }
 
   // The nearest a drop is drawn: nearer, it is far out of focus for an eye or camera looking at the
   // road, a faint blur that would be the largest streak of all.
@@ -139,6 +142,8 @@ class RainLayer {
   int tiles_x_ = 0;
   std::vector<std::uint8_t> tile_lit_;
   std::vector<Bounds> runs_;
+  std::size_t clear_runs_ = 0;
+  std::vector<Bounds> edge_runs_;  // this frame's runs of edge tiles, before they join runs_
 };
 
 }  // namespace downpour::render

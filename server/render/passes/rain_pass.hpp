@@ -23,13 +23,14 @@ RainLayerInputs rain_layer_inputs(const FrameContext& frame, int layer_height,
 // Rain in the air (seed 004): the simulation's drops near the car as streaks, their motion relative
 // to the camera during the exposure, in the light around them and faded with distance. They are
 // drawn on the CPU into a layer of half the view's size (rain_layer.hpp), where the cars hide what
-// falls behind them. This pass composites it over the scene at the windshield's depth, so that the
-// depth test leaves the cabin dry: one texture fetch and no depth per pixel (a depth per texel,
-// tested per pixel, took a second fetch and a depth written per pixel, and made the 10,000-streak
-// pass about 30% dearer on llvmpipe). It draws only the layer's tiles with rain, and not those the
-// cabin hides wholly (cabin_tiles.hpp): a fragment the depth test rejects still costs. In COCKPIT
-// it runs before the glass passes, so the water on the glass refracts the scene with the rain in
-// it.
+// falls behind them. This pass composites it over the scene: one texture fetch per pixel, over the
+// layer's tiles with rain only. In the driver's views the cabin settles which tiles
+// (cabin_tiles.hpp): those it hides wholly are left out (a fragment the depth test rejects still
+// costs), those it reaches into are drawn at the windshield's depth, so that the depth test leaves
+// the cabin dry, and the rest without a depth test (a depth per texel, tested per pixel, took a
+// second fetch and a depth written per pixel, and made the 10,000-streak pass about 30% dearer on
+// llvmpipe). In COCKPIT it runs before the glass passes, so the water on the glass refracts the
+// scene with the rain in it.
 class RainPass final : public Pass {
  public:
   explicit RainPass(SharedResources& shared);

@@ -1,7 +1,9 @@
 // The rain layer on the CPU (no GL): a box hides the streaks behind it and not those in front of
 // it, on the texels inside its outline; the composite's runs of tiles cover every texel with rain
-// and, for rain in one part of the view, little else.
+// and, for rain in one part of the view, little else; the cabin's tiles are left out or put apart.
 #include "server/render/rain_layer.hpp"
+
+#include "server/render/cabin_tiles.hpp"
 
 #include <gtest/gtest.h>
 #include <glm/ext/matrix_transform.hpp>
@@ -86,6 +88,45 @@ TEST(RainLayerTest, TheRunsCoverEveryTexelWithRainAndLittleElse) {
   }
   EXPECT_GT(lit, 20);
   EXPECT_LT(covered, kWidth * kHeight / 4) << "runs over a corner of rain, not the view";
+}
+
+TEST(RainLayerTest, TheCabinsTilesAreLeftOutOrDrawnApart) {
+  // Rain over the whole view; the cabin hides the left third of the tiles and reaches into the
+  // column after it.
+  std::vector<glm::vec3> drops;
+  for (int i = 0; i < 4000; ++i)
+    drops.emplace_back(6.0f + 0.01f * (i % 7), -4.0f + 0.002f * i,
+                       -3.0f + 0.0015f * ((i * 37) % 4000));
+  constexpr int kTilesX = kWidth / RainLayer::kTile;
+  constexpr int kTilesY = (kHeight + RainLayer::kTile - 1) / RainLayer::kTile;
+  std::vector<std::uint8_t> cabin(kTilesX * kTilesY, kCabinClear);
+  for (int ty = 0; ty < kTilesY; ++ty) {
+    for (int tx = 0; tx < kTilesX / 3; ++tx) cabin[ty * kTilesX + tx] = kCabinHidden;
+    cabin[ty * kTilesX + kTilesX / 3] = kCabinEdge;
+  }
+  RainLayerInputs in = inputs();
+  in.cabin_tiles = cabin;
+  RainLayer layer;
+  layer.build(rain_at(drops), in, kWidth, kHeight);
+  const std::vector<RainLayer::Bounds>& runs = layer.runs();
+  ASSERT_GT(layer.clear_runs(), 0u);
+  ASSERT_LT(layer.clear_runs(), runs.size()) << "some runs of edge tiles";
+  int clear_tiles = 0, edge_tiles = 0;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const RainLayer::Bounds& r = runs[k];
+    for (int tx = r.x0 / RainLayer::kTile; tx * RainLayer::kTile < r.x1; ++tx) {
+      const std::uint8_t c = cabin[(r.y0 / RainLayer::kTile) * kTilesX + tx];
+      EXPECT_NE(c, kCabinHidden) << "run " << k;
+      EXPECT_EQ(c, k < layer.clear_runs() ? kCabinClear : kCabinEdge) << "run " << k;
+      (c == kCabinEdge ? edge_tiles : clear_tiles) += 1;
+    }
+  }
+  EXPECT_GT(edge_tiles, kTilesY / 2) << "most of the edge column has rain";
+  EXPECT_GT(clear_tiles, (kTilesX - kTilesX / 3 - 1) * kTilesY / 2) << "most clear tiles have rain";
+  // Without a cabin, every run is clear.
+  in.cabin_tiles = {};
+  layer.build(rain_at(drops), in, kWidth, kHeight);
+  EXPECT_EQ(layer.clear_runs(), layer.runs().size());
 }
 
 }  // namespace
