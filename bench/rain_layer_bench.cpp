@@ -12,8 +12,10 @@
 #include <CLI/CLI.hpp>
 
 #include "server/render/atmosphere.hpp"
+#include "server/render/cabin_tiles.hpp"
 #include "server/render/camera.hpp"
 #include "server/render/passes/rain_pass.hpp"
+#include "server/render/vehicle_geometry.hpp"
 #include "server/sim/pose.hpp"
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"
@@ -69,6 +71,7 @@ int main(int argc, char** argv) {
     for (double t = 0.0; t < 2.0; t += dt) step();
     render::RainLayer layer;
     std::vector<render::RainOccluder> occluders;
+    std::vector<std::uint8_t> cabin;
     std::vector<double> ms, streaks, splashes;
     for (int i = 0; i < frames + 3; ++i) {
       step();
@@ -82,7 +85,13 @@ int main(int argc, char** argv) {
                                        glm::mat4(sim::vehicle_to_world(state.vehicle)),
                                        render::GlassView(camera, state.glass, spec.height),
                                        [&]() -> const sim::SceneState& { return state; }};
-      const render::RainLayerInputs in = render::rain_layer_inputs(frame, layer_h, occluders);
+      render::RainLayerInputs in = render::rain_layer_inputs(frame, layer_h, occluders);
+      // The cabin's tiles, as the pass has them (made once per camera there).
+      if (cabin.empty()) {
+        cabin = render::cabin_tiles(render::build_cockpit_interior(state.glass), camera, layer_w,
+                                    layer_h, render::RainLayer::kTile);
+      }
+      in.cabin_tiles = cabin;
       const auto t0 = std::chrono::steady_clock::now();
       const std::uint32_t drawn = layer.build(state.rain, in, layer_w, layer_h);
       const auto t1 = std::chrono::steady_clock::now();

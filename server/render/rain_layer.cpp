@@ -401,31 +401,54 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
     hazed[i] = glm::uvec3(c * 255.0f + 0.5f);
   }
   // Rows [y0, y1), whole rows of tiles but at the layer's ends (two threads mark tiles apart).
+  const bool cabin = in.cabin_tiles.size() == tile_lit_.size();
+  // Branch-free over every texel of the rows (whether a texel has rain is as good as random, and
+  // a branch on it mispredicts often); untouched texels come out 0.
   auto resolve_rows = [&](int y0, int y1) {
+    const int x0 = b.x0, n = b.x1 - b.x0;
     for (int y = y0; y < y1; ++y) {
-      const std::size_t row = static_cast<std::size_t>(y) * width;
-      std::uint8_t* tiles = &tile_lit_[static_cast<std::size_t>(y / kTile) * tiles_x_];
-      for (int x = b.x0; x < b.x1; ++x) {
-        Texel& first = texels_[row + x];
-        Texel& second = second_[row + x];
-        if (first.depth == kUntouched && second.depth == kUntouched) continue;
-        // Read and leave clear for the next frame.
-        const Texel t = std::exchange(first, Texel{});
-        const Texel u = std::exchange(second, Texel{});
-        const float alpha = t.alpha + u.alpha;
-        if (alpha <= 0.0f) continue;
-        const float depth = std::min(t.depth, u.depth);
+      const std::size_t row = static_cast<std::size_t>(y) * width + x0;
+      Texel* first = &texels_[row];
+      Texel* second = &second_[row];
+      std::uint32_t* out = &colour_[row];
+      const std::uint8_t* hidden_row =
+          cabin ? &in.cabin_tiles[static_cast<std::size_t>(y / kTile) * tiles_x_] : nullptr;
+      int next_tile = 0;  // the next texel (from x0) that starts a tile
+      for (int i = 0; i < n; ++i) {
+        if (i == next_tile) {
+          // A tile the cabin hides wholly: left 0 (the composite leaves it out).
+          const int tx = (x0 + i) / kTile;
+          next_tile = (tx + 1) * kTile - x0;
+          if (hidden_row && hidden_row[tx] == kCabinHidden) {
+            i = std::min(next_tile, n) - 1;
+            continue;
+          }
+        }
+        const float alpha = first[i].alpha + second[i].alpha;
+        const float depth = std::min(first[i].depth, second[i].depth);
         const std::uint32_t a = coverage.at(alpha);
-        const glm::uvec3& c = hazed[std::min(static_cast<int>(depth / kHazeStepM), kHazeSteps)];
+        const glm::uvec3& c = hazed[static_cast<int>(
+            std::min(depth * (1.0f / kHazeStepM), static_cast<float>(kHazeSteps)))];
         // Premultiplied: each channel times the coverage, rounded, in bytes.
-        colour_[row + x] = ((c.r * a + 127) / 255) | ((c.g * a + 127) / 255) << 8 |
-                           ((c.b * a + 127) / 255) << 16 | a << 24;
-        // The tile, and which of its edges has rain (bilinear magnification carries a quarter of
-        // an edge texel into the next tile's first pixels).
-        const int tx = x % kTile, ty = y % kTile;
-        tiles[x / kTile] |= kTileLit | (tx == 0 ? kTileLeft : 0) |
-                            (tx == kTile - 1 ? kTileRight : 0) | (ty == 0 ? kTileBottom : 0) |
-                            (ty == kTile - 1 ? kTileTop : 0);
+        out[i] = ((c.r * a + 127) / 255) | ((c.g * a + 127) / 255) << 8 |
+                 ((c.b * a + 127) / 255) << 16 | a << 24;
+      }
+      // Left clear for the next frame.
+      std::fill_n(first, n, Texel{});
+      std::fill_n(second, n, Texel{});
+      // Each tile of the row with rain, and which of its edges has rain (bilinear magnification
+      // carries a quarter of an edge texel into the next tile's first pixels).
+      std::uint8_t* tiles = &tile_lit_[static_cast<std::size_t>(y / kTile) * tiles_x_];
+      const std::uint8_t row_edge =
+          (y % kTile == 0 ? kTileBottom : 0) | (y % kTile == kTile - 1 ? kTileTop : 0);
+      for (int tx = x0 / kTile; tx * kTile < b.x1; ++tx) {
+        const int t0 = std::max(tx * kTile, x0), t1 = std::min((tx + 1) * kTile, b.x1);
+        bool any = false;
+        for (int x = t0; x < t1; ++x) any |= out[x - x0] != 0u;
+        if (!any) continue;
+        const bool left = tx * kTile >= x0 && out[tx * kTile - x0] != 0u;
+        const bool right = (tx + 1) * kTile <= b.x1 && out[(tx + 1) * kTile - 1 - x0] != 0u;
+        tiles[tx] |= kTileLit | row_edge | (left ? kTileLeft : 0) | (right ? kTileRight : 0);
       }
     }
   };
@@ -450,7 +473,6 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
   };
   // What each tile is to the composite: left out, drawn as it is, or drawn depth-tested (the
   // cabin reaches into it).
-  const bool cabin = in.cabin_tiles.size() == tile_lit_.size();
   enum Draw { kSkip, kClear, kEdge };
   auto draw_as = [&](int tx, int ty) {
     const std::uint8_t c = cabin ? in.cabin_tiles[static_cast<std::size_t>(ty) * tiles_x_ + tx]
