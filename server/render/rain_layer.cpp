@@ -45,8 +45,10 @@ struct CoverageTable {
   static constexpr int kSteps = 512;
   static constexpr float kMax = 8.0f;
   std::uint32_t coverage[kSteps + 1];
-  std::uint32_t at(float alpha) const {
-    return coverage[std::min(static_cast<int>(alpha * (kSteps / kMax) + 0.5f), kSteps)];
+  // For a sum in RainLayer's units (1/4096): alpha * kSteps / kMax is sum / 64.
+  std::uint32_t at_units(std::uint32_t sum) const {
+    static_assert(kSteps / kMax * 64.0f == 4096.0f);
+    return coverage[std::min((sum + 32) / 64, std::uint32_t{kSteps})];
   }
 };
 const CoverageTable& coverage_table() {
@@ -150,6 +152,8 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
   const SpeedTable& speeds = speed_table();
   constexpr int kHazeSteps = 256;
   constexpr float kHazeStepM = 64.0f / kHazeSteps;
+  constexpr std::uint32_t kHazeStepCm = 25;  // kHazeStepM
+  static_assert(kHazeStepCm == static_cast<std::uint32_t>(kHazeStepM * 100.0f));
   float transmittance[kHazeSteps + 1];
   for (int i = 0; i <= kHazeSteps; ++i)
     transmittance[i] = std::exp(-in.haze_per_m * i * kHazeStepM);
@@ -246,12 +250,11 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
   };
   // What a streak leaves in a texel, unless a car nearer than it covers the texel (`occluded`: the
   // occluders' depths, or null for a streak that lies wholly outside them).
-  const float* const occluded = occlude(in, sx, sy, cx, cy);
-  auto put = [](std::vector<Texel>& out, const float* occluded, std::size_t i, float alpha,
-                float depth) {
+  const std::uint16_t* const occluded = occlude(in, sx, sy, cx, cy);
+  auto put = [](std::vector<Texel>& out, const std::uint16_t* occluded, std::size_t i,
+                std::uint32_t alpha, std::uint16_t depth) {
     if (occluded && depth > occluded[i]) return;
-    out[i].alpha += alpha;
-    out[i].depth = std::min(out[i].depth, depth);
+    add(out[i], alpha, depth);
   };
   auto draw = [&](std::size_t begin, std::size_t end, std::vector<Texel>& out, Bounds& dirty,
                   Batch& bt) {
@@ -272,6 +275,9 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
           ++drawn;
           const float hx = bt.hx[c][i], hy = bt.hy[c][i], tx = bt.tx[c][i], ty = bt.ty[c][i];
           const float depth = bt.depth[c][i], true_width = bt.width[c][i];
+          const float units = alpha * kAlphaUnits;
+          const auto whole = static_cast<std::uint32_t>(units + 0.5f);
+          const std::uint16_t depth_c = depth_cm(depth);
           const float dx = tx - hx, dy = ty - hy;
 
           // A Wu line, clipped to the layer: one texel a column along its major axis, shared by the
@@ -334,19 +340,20 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
                                          minor_lo < occluded_.y1 && minor_hi > occluded_.y0
                                    : first < occluded_.y1 && last >= occluded_.y0 &&
                                          minor_lo < occluded_.x1 && minor_hi > occluded_.x0);
-          const float* occ = near_occluder ? occluded : nullptr;
+          const std::uint16_t* occ = near_occluder ? occluded : nullptr;
           for (int m = first; m <= last; ++m) {
             // Evaluated afresh at each column (not summed), so that it stays between its ends.
             const float b = b_at(static_cast<float>(m));
             const int base = std::clamp(static_cast<int>(b), base_lo, base_hi);
             const float frac = std::clamp(b - static_cast<float>(base), 0.0f, 1.0f);
             std::size_t i = m * major_stride + (base - extra) * minor_stride;
-            put(out, occ, i, alpha * (1.0f - frac), depth);
+            const auto far_share = static_cast<std::uint32_t>(units * frac + 0.5f);
+            put(out, occ, i, whole - std::min(far_share, whole), depth_c);
             for (int k = 1 - extra; k <= extra; ++k) {
               i += minor_stride;
-              put(out, occ, i, alpha, depth);
+              put(out, occ, i, whole, depth_c);
             }
-            put(out, occ, i + minor_stride, alpha * frac, depth);
+            put(out, occ, i + minor_stride, far_share, depth_c);
           }
           b_min -= extra;
           b_max += extra + 2;
@@ -424,11 +431,10 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
             continue;
           }
         }
-        const float alpha = first[i].alpha + second[i].alpha;
-        const float depth = std::min(first[i].depth, second[i].depth);
-        const std::uint32_t a = coverage.at(alpha);
-        const glm::uvec3& c = hazed[static_cast<int>(
-            std::min(depth * (1.0f / kHazeStepM), static_cast<float>(kHazeSteps)))];
+        const std::uint32_t sum = std::uint32_t{first[i].alpha} + second[i].alpha;
+        const std::uint32_t depth = std::min(first[i].depth, second[i].depth);
+        const std::uint32_t a = coverage.at_units(sum);
+        const glm::uvec3& c = hazed[std::min(depth / kHazeStepCm, std::uint32_t{kHazeSteps})];
         // Premultiplied: each channel times the coverage, rounded, in bytes.
         out[i] = ((c.r * a + 127) / 255) | ((c.g * a + 127) / 255) << 8 |
                  ((c.b * a + 127) / 255) << 16 | a << 24;
@@ -503,7 +509,8 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
   return drawn;
 }
 
-const float* RainLayer::occlude(const RainLayerInputs& in, float sx, float sy, float cx, float cy) {
+const std::uint16_t* RainLayer::occlude(const RainLayerInputs& in, float sx, float sy, float cx,
+                                        float cy) {
   // Last frame's rectangles back to none.
   for (int y = occluded_.y0; y < occluded_.y1; ++y) {
     std::fill_n(occluder_depth_.begin() + static_cast<std::size_t>(y) * width_ + occluded_.x0,
@@ -514,7 +521,7 @@ const float* RainLayer::occlude(const RainLayerInputs& in, float sx, float sy, f
   for (const RainOccluder& o : in.occluders) {
     // To the camera in double (the world is kilometres wide), then float.
     const glm::mat4 to_camera(glm::dmat4(in.view) * o.to_world);
-    float near = kUntouched;
+    float near = 1e30f;
     glm::vec2 corners[8];
     bool behind = false;
     for (int c = 0; c < 8; ++c) {
@@ -551,8 +558,9 @@ const float* RainLayer::occlude(const RainLayerInputs& in, float sx, float sy, f
       const int ix1 =
           std::min(width_ - 1, static_cast<int>(std::floor(std::min(x_hi, 1e7f) - 0.5f)));
       if (ix0 > ix1) continue;
-      float* row = &occluder_depth_[static_cast<std::size_t>(y) * width_];
-      for (int x = ix0; x <= ix1; ++x) row[x] = std::min(row[x], near);
+      std::uint16_t* row = &occluder_depth_[static_cast<std::size_t>(y) * width_];
+      const std::uint16_t near_cm = depth_cm(near);
+      for (int x = ix0; x <= ix1; ++x) row[x] = std::min(row[x], near_cm);
       const Bounds span{ix0, y, ix1 + 1, y + 1};
       occluded_ = occluded_.empty()
                       ? span
@@ -581,10 +589,11 @@ RainLayer::Bounds RainLayer::draw_splashes(const sim::RainState& rain, const Rai
     const std::size_t at = static_cast<std::size_t>(iy) * width_ + ix;
     const float w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
     const std::size_t texel[4] = {at, at + 1, at + width_, at + width_ + 1};
+    const std::uint16_t depth_c = depth_cm(depth);
     for (int k = 0; k < 4; ++k) {
-      if (occludable && !occluded_.empty() && depth > occluder_depth_[texel[k]]) continue;
-      texels_[texel[k]].alpha += alpha * w[k];
-      texels_[texel[k]].depth = std::min(texels_[texel[k]].depth, depth);
+      if (occludable && !occluded_.empty() && depth_c > occluder_depth_[texel[k]]) continue;
+      add(texels_[texel[k]], static_cast<std::uint32_t>(alpha * w[k] * kAlphaUnits + 0.5f),
+          depth_c);
     }
     lo_x = std::min(lo_x, ix), hi_x = std::max(hi_x, ix + 2);
     lo_y = std::min(lo_y, iy), hi_y = std::max(hi_y, iy + 2);
