@@ -1,5 +1,6 @@
 #include "server/render/passes/rain_pass.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include <glm/gtc/matrix_inverse.hpp>
@@ -86,57 +87,36 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
   const int height = (frame.spec.height + kLayerDivisor - 1) / kLayerDivisor;
   RainLayerInputs in = rain_layer_inputs(frame, height, occluders_);
   if (is_driver_view(frame.spec.view)) in.cabin_tiles = cabin_tiles_for(frame, width, height);
+  Sized& sized = this->sized(width, height);
+  RainLayer& layer = sized.layer;
   const auto t0 = std::chrono::steady_clock::now();
-  drawn_.streaks = layer_.build(rain, in, width, height);
+  drawn_.streaks = layer.build(rain, in, width, height);
   drawn_.layer_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
-  if (width != texture_width_ || height != texture_height_) {
-    for (Texture& texture : colour_) {
-      texture = make_texture_2d(GL_RGBA8, width, height);
-      glTextureParameteri(texture.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      glTextureParameteri(texture.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-      glTextureParameteri(texture.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-      glTextureParameteri(texture.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    }
-    // Room for a run per tile, the most there can be (each covers a tile at least).
-    const GLsizeiptr capacity = static_cast<GLsizeiptr>(sizeof(glm::vec4)) *
-                                ((width + RainLayer::kTile - 1) / RainLayer::kTile) *
-                                ((height + RainLayer::kTile - 1) / RainLayer::kTile);
-    for (Buffer& buffer : runs_buffer_) {
-      GLuint id = 0;
-      glCreateBuffers(1, &id);
-      glNamedBufferStorage(id, capacity, nullptr, GL_DYNAMIC_STORAGE_BIT);
-      buffer = Buffer(id);
-    }
-    texture_width_ = width;
-    texture_height_ = height;
-  }
-  const Texture& texture = colour_[next_texture_];
+  const Texture& texture = sized.colour[sized.next];
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTextureSubImage2D(texture.id(), 0, 0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE,
-                      layer_.colour().data());
+                      layer.colour().data());
   glBindTextureUnit(texture_unit::kRainLayer, texture.id());
-  const std::vector<RainLayer::Bounds>& runs = layer_.runs();
+  const std::vector<RainLayer::Bounds>& runs = layer.runs();
+  const Buffer& buffer = sized.runs_buffer[sized.next];
+  sized.next = (sized.next + 1) % kTextures;
   if (runs.empty()) return;
   // Only the tiles with rain: on llvmpipe the composite's cost is the area it covers, lit or not.
   runs_uv_.clear();
   const glm::vec2 texel(1.0f / width, 1.0f / height);
   for (const RainLayer::Bounds& r : runs)
     runs_uv_.emplace_back(r.x0 * texel.x, r.y0 * texel.y, r.x1 * texel.x, r.y1 * texel.y);
-  // A buffer for each frame in turn, as the textures, so that the upload never waits for the draw
-  // before.
-  const Buffer& buffer = runs_buffer_[next_texture_];
   glNamedBufferSubData(buffer.id(), 0, static_cast<GLsizeiptr>(runs_uv_.size() * sizeof(glm::vec4)),
                        runs_uv_.data());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buffer.id());
-  next_texture_ = (next_texture_ + 1) % kTextures;
   program_.use();
   glBindVertexArray(vao_.id());
   // The tiles clear of the cabin (all of them but in the driver's views) need no depth test: the
   // rain there lies beyond anything drawn nearer than the glass. On llvmpipe the test costs about a
   // quarter of the composite.
-  const auto clear = static_cast<GLsizei>(layer_.clear_runs());
+  const auto clear = static_cast<GLsizei>(layer.clear_runs());
   glDisable(GL_DEPTH_TEST);
   if (clear > 0) glDrawArrays(GL_TRIANGLES, 0, 6 * clear);
   glEnable(GL_DEPTH_TEST);  // the pass's own state again (decl_)
@@ -148,6 +128,39 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
   glEnable(GL_DEPTH_CLAMP);
   glDrawArrays(GL_TRIANGLES, 6 * clear, 6 * edge);
   glDisable(GL_DEPTH_CLAMP);
+}
+
+RainPass::Sized& RainPass::sized(int width, int height) {
+  const auto found = std::find_if(sized_.begin(), sized_.end(), [&](const auto& s) {
+    return s->width == width && s->height == height;
+  });
+  if (found != sized_.end()) {
+    std::rotate(found, found + 1, sized_.end());  // the most recently used, last
+    return *sized_.back();
+  }
+  if (sized_.size() >= kSizesKept) sized_.erase(sized_.begin());
+  auto s = std::make_unique<Sized>();
+  s->width = width;
+  s->height = height;
+  for (Texture& texture : s->colour) {
+    texture = make_texture_2d(GL_RGBA8, width, height);
+    glTextureParameteri(texture.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(texture.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(texture.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(texture.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  }
+  // Room for a run per tile, the most there can be (each covers a tile at least).
+  const GLsizeiptr capacity = static_cast<GLsizeiptr>(sizeof(glm::vec4)) *
+                              ((width + RainLayer::kTile - 1) / RainLayer::kTile) *
+                              ((height + RainLayer::kTile - 1) / RainLayer::kTile);
+  for (Buffer& buffer : s->runs_buffer) {
+    GLuint id = 0;
+    glCreateBuffers(1, &id);
+    glNamedBufferStorage(id, capacity, nullptr, GL_DYNAMIC_STORAGE_BIT);
+    buffer = Buffer(id);
+  }
+  sized_.push_back(std::move(s));
+  return *sized_.back();
 }
 
 const std::vector<std::uint8_t>& RainPass::cabin_tiles_for(const FrameContext& frame, int width,

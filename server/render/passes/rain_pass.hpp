@@ -1,5 +1,6 @@
 #pragma once
 
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -56,7 +57,6 @@ class RainPass final : public Pass {
   SharedResources& shared_;
   ShaderProgram program_;
   Uniform u_plane_depth_;
-  RainLayer layer_;
   std::vector<RainOccluder> occluders_;  // this frame's cars, for the layer
   // The layer's tiles that the cabin hides, per driver's camera (cabin_tiles.hpp), the latest few.
   struct CabinTiles {
@@ -70,15 +70,23 @@ class RainPass final : public Pass {
   const std::vector<std::uint8_t>& cabin_tiles_for(const FrameContext& frame, int width,
                                                    int height);
   std::vector<CabinTiles> cabin_tiles_;
-  // A few layer textures in turn, so that an upload never waits for the GPU to finish drawing with
-  // the one before.
+  // What a layer size needs: the layer, and a few textures and run buffers used in turn, so that
+  // an upload never waits for the GPU to finish drawing with the one before. Kept per size for
+  // the latest few sizes (kSizesKept), so that sessions whose views differ in size, rendered in
+  // turn, re-create nothing; each layer has a helper thread of its own.
   static constexpr int kTextures = 3;
-  Texture colour_[kTextures];
-  Buffer runs_buffer_[kTextures];  // the runs of tiles to draw, uv over the view (rain.vert)
+  static constexpr std::size_t kSizesKept = 4;
+  struct Sized {
+    int width = 0, height = 0;
+    RainLayer layer;
+    Texture colour[kTextures];
+    Buffer runs_buffer[kTextures];  // the runs of tiles to draw, uv over the view (rain.vert)
+    int next = 0;
+  };
+  Sized& sized(int width, int height);
+  std::vector<std::unique_ptr<Sized>> sized_;  // the most recently used last
   std::vector<glm::vec4> runs_uv_;
   VertexArray vao_;  // none of its own attributes: rain.vert reads the runs
-  int next_texture_ = 0;
-  int texture_width_ = 0, texture_height_ = 0;
   Drawn drawn_;
 };
 
