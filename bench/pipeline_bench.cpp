@@ -21,6 +21,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "bench/stats.hpp"
 #include "server/encode/jpeg_encoder.hpp"
 #include "server/render/renderer.hpp"
 #include "server/session/frame_scheduler.hpp"
@@ -37,12 +38,8 @@ double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
 
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * v.size()))];
-}
-double median(std::vector<double> v) { return percentile(std::move(v), 0.5); }
+using bench::median;
+using bench::percentile;
 
 // CPU time of the whole process (every thread: llvmpipe's rasterizers, the step, the encoder).
 double cpu_time_ms() {

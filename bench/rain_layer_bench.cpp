@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bench/stats.hpp"
 #include "server/render/atmosphere.hpp"
 #include "server/render/cabin_tiles.hpp"
 #include "server/render/camera.hpp"
@@ -22,15 +23,7 @@
 
 using namespace downpour;
 
-namespace {
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[static_cast<std::size_t>(p * (v.size() - 1) + 0.5)];
-}
-
-}  // namespace
+using bench::percentile;
 
 int main(int argc, char** argv) {
   // The counts that draw about 10,000 and 80,000 streaks from the driver's eye (downpour-bench's

@@ -19,11 +19,6 @@ double cpu_time_ms() {
 
 }  // namespace
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
-}
-
 double ViewCost::windshield_passes_ms() const {
   double sum = 0.0;
   for (const auto& [name, ms] : passes) {

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "bench/stats.hpp"
 #include "server/sim/simulation.hpp"
 
 namespace downpour::bench {
@@ -28,8 +29,6 @@ struct ViewCost {
   // The sum of the glass passes (glass_*, and the WINDSHIELD view's own): the windshield's cost.
   double windshield_passes_ms() const;
 };
-
-double median(std::vector<double> values);
 
 std::vector<ViewCost> measure_views(const std::vector<NamedView>& views, const sim::SceneState& wet,
                                     int frames);
