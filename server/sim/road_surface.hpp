@@ -18,19 +18,22 @@ namespace downpour::sim {
 class RoadSurface {
  public:
   // Wheel paths: two per lane, this far either side of the lane's centre (a car's track is about
-  // 1.6 m), each a rut of this half-width whose depth varies along the road between these.
+  // 1.6 m), each a rut of this half-width whose depth varies along the road between these (a worn
+  // road's ruts: 6-13 mm is "low severity"; a rut holds water across the crown's 2% where its side
+  // is steeper, past about 4.5 mm).
   static constexpr double kWheelPathOffsetM = 0.8;
   static constexpr double kRutHalfWidthM = 0.35;
-  static constexpr double kRutMinDepthM = 0.002;
-  static constexpr double kRutMaxDepthM = 0.006;
+  static constexpr double kRutMinDepthM = 0.003;
+  static constexpr double kRutMaxDepthM = 0.010;
   static constexpr double kRutKnotM = 30.0;  // the depth's knots along the road, eased between
-  // Depressions: bowls about one per kDepressionSpacingM of road, of these radii and depths (worn
-  // or settled patches of asphalt; a real road's tolerance is about 5 mm under a 3 m straightedge).
+  // Depressions: bowls about one per kDepressionSpacingM of road, of these radii and depths
+  // (settled patches of asphalt: 13-25 mm is a "moderate" depression). On the crown's slope a bowl
+  // holds water only where its side is steeper than the slope, depth over radius past about 0.013.
   static constexpr double kDepressionSpacingM = 12.0;
-  static constexpr double kDepressionMinRadiusM = 0.6;
-  static constexpr double kDepressionMaxRadiusM = 2.5;
-  static constexpr double kDepressionMinDepthM = 0.003;
-  static constexpr double kDepressionMaxDepthM = 0.012;
+  static constexpr double kDepressionMinRadiusM = 0.5;
+  static constexpr double kDepressionMaxRadiusM = 2.0;
+  static constexpr double kDepressionMinDepthM = 0.005;
+  static constexpr double kDepressionMaxDepthM = 0.025;
   // No bowl reaches within this of the crown's top (it lies across wheel paths or near the edge).
   static constexpr double kCrownClearM = 0.5;
 
@@ -45,6 +48,10 @@ class RoadSurface {
   double height_at(double s, double lateral) const;
   // The relief below the track's section there (m, <= 0): ruts and depressions.
   double relief(double s, double lateral) const;
+  // The track's coordinates of a horizontal world position near the centreline point s_guess
+  // (within a few metres along it, as a neighbouring position's): a few Newton steps from the
+  // guess, much cheaper than a search of the whole track.
+  Track::Projection project_near(glm::dvec2 xy, double s_guess) const;
   // Whether a lateral offset is on the paved width (lanes and shoulders).
   bool paved(double lateral) const;
 
