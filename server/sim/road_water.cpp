@@ -28,53 +28,83 @@ RoadWater::RoadWater(const RoadSurface& surface, RoadWaterConfig config)
 
 RoadState RoadWater::state_of(double water_m) const {
   if (water_m < config_.wet_m) return RoadState::kDry;
-  if (water_m <= config_.capacity_m) return RoadState::kWet;
-  return water_m - config_.capacity_m < config_.puddle_m ? RoadState::kDrench : RoadState::kPuddle;
+  const double standing = water_m - config_.capacity_m;
+  return standing < config_.drench_m   ? RoadState::kWet
+         : standing < config_.puddle_m ? RoadState::kDrench
+                                       : RoadState::kPuddle;
 }
 
 RoadWater::Key RoadWater::record_key(glm::ivec2 world) const {
   return {floor_div(world.x, record_cells_), floor_div(world.y, record_cells_)};
 }
 
-double RoadWater::evaporate_record(Record& r) {
+void RoadWater::settle(Record& r) {
+  const double left = r.film_m3 * std::exp(-(time_s_ - r.time_s) / config_.film_runoff_s);
+  ledger_.drained_m3 += r.film_m3 - left;
+  r.film_m3 = left;
   const double area = config_.cell_m * config_.cell_m * r.cells_out;
   const double gone =
       std::min(r.volume_m3, config_.evaporation_m_per_s * (dry_time_s_ - r.dry_time_s) * area);
   r.volume_m3 -= gone;
-  r.dry_time_s = dry_time_s_;
   ledger_.evaporated_m3 += gone;
-  return gone;
+  r.dry_time_s = dry_time_s_;
+  r.time_s = time_s_;
 }
 
 void RoadWater::leave_cell(int i, int j) {
   const std::size_t c = static_cast<std::size_t>(j) * n_ + i;
-  const double volume = water_[c] * config_.cell_m * config_.cell_m;
-  const Key key = record_key(origin_ + glm::ivec2(i, j));
+  const double area = config_.cell_m * config_.cell_m;
+  const double w = water_[c];
+  water_[c] = 0.0;
+  const glm::ivec2 world = origin_ + glm::ivec2(i, j);
+  if (state_of(w) == RoadState::kPuddle) {
+    puddle_cells_.emplace(Key{world.x, world.y}, Record{w * area, 0.0, 1, dry_time_s_, time_s_});
+    return;
+  }
+  const Key key = record_key(world);
   auto found = records_.find(key);
   if (found == records_.end()) {
-    if (volume <= 0.0) return;  // a dry cell leaves nothing to keep
-    found = records_.emplace(key, Record{0.0, 0, dry_time_s_}).first;
+    if (w <= 0.0) return;  // a dry cell leaves nothing to keep
+    found = records_.emplace(key, Record{0.0, 0.0, 0, dry_time_s_, time_s_}).first;
   }
-  evaporate_record(found->second);
-  found->second.volume_m3 += volume;
-  found->second.cells_out += 1;
-  water_[c] = 0.0;
+  Record& r = found->second;
+  settle(r);
+  r.volume_m3 += std::min(w, config_.capacity_m) * area;
+  r.film_m3 += std::max(w - config_.capacity_m, 0.0) * area;
+  r.cells_out += 1;
 }
 
-void RoadWater::fill_cell(int i, int j, glm::ivec2 world, double s_guess) {
+void RoadWater::fill_cell(int i, int j, glm::ivec2 world, double s_guess, double fresh_m) {
   const std::size_t c = static_cast<std::size_t>(j) * n_ + i;
   const glm::dvec2 xy = (glm::dvec2(world) + 0.5) * config_.cell_m;
   const Track::Projection p = surface_.project_near(xy, s_guess);
   ground_[c] = surface_.height_at(p.s, p.lateral);
   paved_[c] = surface_.paved(p.lateral);
   water_[c] = 0.0;
+  const auto puddle = puddle_cells_.find(Key{world.x, world.y});
+  if (puddle != puddle_cells_.end()) {
+    settle(puddle->second);
+    water_[c] = puddle->second.volume_m3 / (config_.cell_m * config_.cell_m);
+    puddle_cells_.erase(puddle);
+    return;
+  }
   const auto found = records_.find(record_key(world));
-  if (found == records_.end()) return;
+  if (found == records_.end()) {
+    // Rain fell here before the window came: as much as its cells hold (it enters the ledger as
+    // rain now).
+    if (paved_[c] && fresh_m > 0.0) {
+      water_[c] = fresh_m;
+      ledger_.rain_in_m3 += fresh_m * config_.cell_m * config_.cell_m;
+    }
+    return;
+  }
   // Its share of the record: the water of the record's cells that are out, evenly.
   Record& r = found->second;
-  evaporate_record(r);
-  const double share = r.cells_out > 1 ? r.volume_m3 / r.cells_out : r.volume_m3;
-  r.volume_m3 -= share;
+  settle(r);
+  const double part = r.cells_out > 1 ? 1.0 / r.cells_out : 1.0;
+  const double share = (r.volume_m3 + r.film_m3) * part;
+  r.volume_m3 -= r.volume_m3 * part;
+  r.film_m3 -= r.film_m3 * part;
   r.cells_out -= 1;
   if (r.cells_out <= 0) records_.erase(found);
   if (paved_[c]) {
@@ -91,12 +121,22 @@ void RoadWater::move_to(glm::ivec2 origin) {
   if (!placed_) {
     origin_ = origin;
     for (int j = 0; j < n_; ++j) {
-      for (int i = 0; i < n_; ++i) fill_cell(i, j, origin_ + glm::ivec2(i, j), s_centre);
+      for (int i = 0; i < n_; ++i) fill_cell(i, j, origin_ + glm::ivec2(i, j), s_centre, 0.0);
     }
     placed_ = true;
     return;
   }
   const glm::ivec2 shift = origin - origin_;
+  // What the road the window has not seen holds: the mean of the window's paved cells but the
+  // puddles (the rain falls there as here; its puddles are its own).
+  double sum = 0.0;
+  std::size_t counted = 0;
+  for (std::size_t c = 0; c < water_.size(); ++c) {
+    if (!paved_[c] || state_of(water_[c]) == RoadState::kPuddle) continue;
+    sum += water_[c];
+    ++counted;
+  }
+  const double fresh_m = counted > 0 ? sum / static_cast<double>(counted) : 0.0;
   auto inside = [&](glm::ivec2 cell) {  // a window cell index
     return cell.x >= 0 && cell.y >= 0 && cell.x < n_ && cell.y < n_;
   };
@@ -123,7 +163,8 @@ void RoadWater::move_to(glm::ivec2 origin) {
   origin_ = origin;
   for (int j = 0; j < n_; ++j) {
     for (int i = 0; i < n_; ++i) {
-      if (!inside(glm::ivec2(i, j) + shift)) fill_cell(i, j, origin_ + glm::ivec2(i, j), s_centre);
+      if (!inside(glm::ivec2(i, j) + shift))
+        fill_cell(i, j, origin_ + glm::ivec2(i, j), s_centre, fresh_m);
     }
   }
 }
@@ -135,6 +176,7 @@ void RoadWater::step(glm::dvec2 centre, double rain_mm_h, double dt_s) {
   const double area = config_.cell_m * config_.cell_m;
   const std::size_t count = water_.size();
   const bool raining = rain_mm_h > 0.0;
+  time_s_ += dt_s;
   if (!raining) dry_time_s_ += dt_s;
 
   // Rain in, or evaporation out (the air is saturated while it rains).
@@ -255,7 +297,8 @@ double RoadWater::stored_m3() const {
   double sum = 0.0;
   for (const double w : water_) sum += w;
   sum *= config_.cell_m * config_.cell_m;
-  for (const auto& [key, r] : records_) sum += r.volume_m3;
+  for (const auto& [key, r] : records_) sum += r.volume_m3 + r.film_m3;
+  for (const auto& [key, r] : puddle_cells_) sum += r.volume_m3;
   return sum;
 }
 

@@ -22,7 +22,7 @@ namespace downpour::sim {
 
 enum class RoadState : std::uint8_t {
   kDry,     // no water to speak of
-  kWet,     // water in the surface's texture, none standing (unsaturated)
+  kWet,     // water in the surface's texture, little or none standing
   kDrench,  // a film standing on the surface (saturated)
   kPuddle,  // standing water at least RoadWaterConfig::puddle_m deep
 };
@@ -36,12 +36,16 @@ struct RoadWaterConfig {
   // asphalt is 0.4-1 mm; a film of about half of it fills the pores).
   double capacity_m = 0.0005;
   double wet_m = 0.00002;    // less than this is dry
+  double drench_m = 0.0001;  // standing water from which a film shows (less is only wet)
   double puddle_m = 0.002;   // standing water from which a cell is a puddle
   double manning_n = 0.016;  // sheet flow over asphalt (Manning's roughness)
   // Evaporation from a wet road once the rain stops: a few tenths of a millimetre an hour under
   // cloud, more in sun and wind and with traffic; none while it rains (the air is saturated).
   double evaporation_m_per_s = 0.4e-3 / 3600.0;
   double record_m = 2.0;  // the coarse records' cells (a whole number of cells)
+  // Out of the window a film keeps running off the road: the time constant of what is left (a film
+  // crosses a half-width of 8 m at about 0.1 m/s).
+  double film_runoff_s = 60.0;
 };
 
 class RoadWater {
@@ -83,17 +87,22 @@ class RoadWater {
 
  private:
   struct Record {
-    double volume_m3 = 0.0;
+    double volume_m3 = 0.0;   // held in the texture (or a puddle's)
+    double film_m3 = 0.0;     // standing as a film: it runs off while out of the window
     int cells_out = 0;        // of its cells, those outside the window with their water here
-    double dry_time_s = 0.0;  // dry_time_s_ when it was last evaporated
+    double dry_time_s = 0.0;  // dry_time_s_ when it was last settled
+    double time_s = 0.0;      // time_s_ then
   };
   using Key = std::pair<int, int>;
 
   void move_to(glm::ivec2 origin);
-  void fill_cell(int i, int j, glm::ivec2 world, double s_guess);  // a cell entering the window
-  void leave_cell(int i, int j);                                   // a cell leaving it
+  // A cell entering the window: its water from its record, or, for a cell the window has not
+  // seen, `fresh_m` (the rain that fell there before: as the window's cells have it).
+  void fill_cell(int i, int j, glm::ivec2 world, double s_guess, double fresh_m);
+  void leave_cell(int i, int j);  // a cell leaving it
   Key record_key(glm::ivec2 world) const;
-  double evaporate_record(Record& r);
+  // Brings a record to now: its film runs off (film_runoff_s), then the rest evaporates.
+  void settle(Record& r);
   int index(glm::dvec2 xy) const;  // -1 outside the window
 
   const RoadSurface& surface_;
@@ -102,11 +111,13 @@ class RoadWater {
   int record_cells_ = 8;  // per side
   bool placed_ = false;
   glm::ivec2 origin_{0};
+  double time_s_ = 0.0;
   double dry_time_s_ = 0.0;  // time stepped without rain: the records evaporate by it
   std::vector<double> ground_, water_;
   std::vector<std::uint8_t> paved_;
   std::vector<double> outflow_, flow_x_, flow_y_;  // one step's flows (m^3), made once
-  std::map<Key, Record> records_;
+  std::map<Key, Record> records_;                  // coarse, by record_m squares
+  std::map<Key, Record> puddle_cells_;             // by cell: a puddle's water (cells_out unused)
   Ledger ledger_;
 };
 
