@@ -100,8 +100,8 @@ json measure_stages(const sim::Scenario& scenario, const sim::ViewSpec& spec, in
   encode::JpegEncoder encoder;
   sim::Simulation simulation(scenario.seed, scenario.at(0.0));
   warm(simulation, scenario, warm_s);
-  std::vector<double> step_ms, water_ms, map_ms, rain_field_ms, render_ms, readback_ms, encode_ms,
-      frame_ms, cpu_ms;
+  std::vector<double> step_ms, water_ms, map_ms, rain_field_ms, road_water_ms, render_ms,
+      readback_ms, encode_ms, frame_ms, cpu_ms;
   std::vector<std::uint8_t> pixels;
   const double dt = 1.0 / scenario.fps;
   constexpr int kWarmup = 3;  // the first frames compile shader variants
@@ -125,6 +125,7 @@ json measure_stages(const sim::Scenario& scenario, const sim::ViewSpec& spec, in
     water_ms.push_back(simulation.last_advance_timing().water_ms);
     map_ms.push_back(simulation.last_advance_timing().publish_ms);
     rain_field_ms.push_back(simulation.last_advance_timing().rain_ms);
+    road_water_ms.push_back(simulation.last_advance_timing().road_ms);
     render_ms.push_back(ms_between(t1, t2));
     readback_ms.push_back(ms_between(t2, t3));
     frame_ms.push_back(ms_between(t1, t3));
@@ -138,6 +139,7 @@ json measure_stages(const sim::Scenario& scenario, const sim::ViewSpec& spec, in
   j["water_step_ms_p90"] = percentile(water_ms, 0.9);
   j["water_map_ms"] = median(map_ms);
   j["rain_field_ms"] = median(rain_field_ms);  // the rain in the air's step and copy
+  j["road_water_ms"] = median(road_water_ms);  // the water on the road's steps
   j["render_submit_ms"] = median(render_ms);   // issuing the commands (llvmpipe rasterizes some)
   j["readback_wait_ms"] = median(readback_ms);
   j["render_thread_ms"] = median(frame_ms);  // render + readback

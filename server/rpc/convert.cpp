@@ -16,6 +16,20 @@ v1::View to_proto(sim::View view) {
   return v1::VIEW_UNSPECIFIED;
 }
 
+v1::RoadState to_proto(sim::RoadState state) {
+  switch (state) {
+    case sim::RoadState::kDry:
+      return v1::ROAD_DRY;
+    case sim::RoadState::kWet:
+      return v1::ROAD_WET;
+    case sim::RoadState::kDrench:
+      return v1::ROAD_DRENCH;
+    case sim::RoadState::kPuddle:
+      return v1::ROAD_PUDDLE;
+  }
+  return v1::ROAD_STATE_UNSPECIFIED;
+}
+
 void fill_frame(const session::EncodedFrame& f, std::uint64_t reader_drops, v1::Frame* out) {
   out->set_session_id(f.session_id);
   out->set_frame_number(f.frame_number);
@@ -36,6 +50,12 @@ void fill_frame(const session::EncodedFrame& f, std::uint64_t reader_drops, v1::
   s->set_rain_streaks(f.stats.rain_streaks);
   s->set_visibility_m(f.stats.visibility_m);
   s->set_frames_dropped(reader_drops);
+  for (const sim::TireWater& t : f.tires) {
+    v1::TireWater* tire = out->add_tires();
+    tire->set_water_mm(t.water_mm);
+    tire->set_standing_mm(t.standing_mm);
+    tire->set_state(to_proto(t.state));
+  }
 }
 
 void fill_session_info(const session::Session& session, v1::SessionInfo* out) {

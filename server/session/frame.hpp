@@ -1,6 +1,7 @@
 // An encoded frame as it leaves the pipeline, shared (read-only) by every reader that gets it.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -31,6 +32,7 @@ struct EncodedFrame {
   int height = 0;
   std::string jpeg;
   FrameStats stats;
+  std::array<sim::TireWater, sim::kTires> tires{};  // the tick's: the road's water under the tires
 };
 
 using FramePtr = std::shared_ptr<const EncodedFrame>;

@@ -70,6 +70,7 @@ struct FrameScheduler::InFlight {
   double view_wet_fraction = 0.0;
   std::uint32_t rain_streaks = 0;
   double visibility_m = 0.0;
+  std::array<sim::TireWater, sim::kTires> tires{};
   Clock::time_point inputs_arrived;
 };
 
@@ -435,6 +436,7 @@ void FrameScheduler::tick(const std::shared_ptr<Session>& s, const StartedStep& 
     f.drops_on_glass = scene.windshield.drops + scene.windshield.particles;
     f.glass_wet_fraction = scene.windshield.glass_wet_fraction;
     f.view_wet_fraction = render::view_wet_fraction(views[f.view_index], scene);
+    f.tires = scene.tires;
     readbacks_->push(readback, std::move(f));
   }
 }
@@ -487,6 +489,7 @@ void FrameScheduler::encode(InFlight f, std::vector<std::uint8_t> pixels, double
     frame->stats.view_wet_fraction = f.view_wet_fraction;
     frame->stats.rain_streaks = f.rain_streaks;
     frame->stats.visibility_m = f.visibility_m;
+    frame->tires = f.tires;
     ++frames_encoded_;
     {
       std::lock_guard lock(stats_mutex_);

@@ -20,4 +20,9 @@ inline constexpr double kRoofFrontX = 1.35;
 inline constexpr double kRoofHalfWidth = 0.71;
 inline constexpr double kRoofZ = 1.47;
 
+// The wheels' contact points: the rear axle is the frame's origin, the front axle a wheelbase
+// ahead, each wheel half the track to a side (a mid-size car's 2.7 m and 1.56 m).
+inline constexpr double kWheelbase = 2.7;
+inline constexpr double kTrackHalfWidth = 0.78;
+
 }  // namespace downpour::sim::car_body

@@ -17,15 +17,9 @@
 #include <glm/vec2.hpp>
 
 #include "server/sim/road_surface.hpp"
+#include "server/sim/types.hpp"
 
 namespace downpour::sim {
-
-enum class RoadState : std::uint8_t {
-  kDry,     // no water to speak of
-  kWet,     // water in the surface's texture, little or none standing
-  kDrench,  // a film standing on the surface (saturated)
-  kPuddle,  // standing water at least RoadWaterConfig::puddle_m deep
-};
 
 struct RoadWaterConfig {
   // S0: a drop's wet spot is a centimetre or two; cells that small around a car would be millions,

@@ -5,9 +5,20 @@
 
 #include <glm/mat3x3.hpp>
 
+#include "server/sim/car_body.hpp"
 #include "server/sim/pose.hpp"
 
 namespace downpour::sim {
+
+namespace {
+
+// The built-in track, made once for every session (the road's relief is per seed).
+const Track& test_track() {
+  static const Track track = Track::test_track();
+  return track;
+}
+
+}  // namespace
 
 Simulation::Simulation(std::uint64_t seed, const Update& initial, SimulationConfig config)
     : config_(config),
@@ -16,7 +27,9 @@ Simulation::Simulation(std::uint64_t seed, const Update& initial, SimulationConf
       water_(config.windshield, seed),
       rain_(seed, config.rain),
       water_map_(config.windshield.glass, config.water_map),
-      blades_at_water_step_(wipers_.poses()) {
+      blades_at_water_step_(wipers_.poses()),
+      surface_(std::make_unique<RoadSurface>(test_track(), seed)),
+      road_(*surface_, config.road) {
   state_.glass = config_.windshield.glass;
   apply(initial);
   publish();
@@ -30,6 +43,16 @@ void Simulation::publish() {
   rain_ms_ +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   state_.windshield.glass_wet_fraction = state_.windshield.map.wet_fraction;
+  // Under each tire: front left, front right, rear left, rear right.
+  const glm::dmat4 to_world = vehicle_to_world(state_.vehicle);
+  for (int t = 0; t < kTires; ++t) {
+    const glm::dvec4 local(t < 2 ? car_body::kWheelbase : 0.0,
+                           t % 2 == 0 ? car_body::kTrackHalfWidth : -car_body::kTrackHalfWidth, 0.0,
+                           1.0);
+    const glm::dvec2 xy(to_world * local);
+    const double water = road_.water_m(xy);
+    state_.tires[t] = {water * 1e3, road_.standing_m(xy) * 1e3, road_.state_of(water)};
+  }
 }
 
 void Simulation::apply(const Update& update) {
@@ -44,6 +67,7 @@ void Simulation::advance(double dt_s) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   rain_ms_ = 0.0;
+  road_ms_ = 0.0;
   carry_s_ += dt_s;
   while (whole_sub_step_due(carry_s_)) {
     sub_step();
@@ -53,7 +77,9 @@ void Simulation::advance(double dt_s) {
   const double rain_step_ms = rain_ms_;
   publish();
   timing_.rain_ms = rain_ms_;
-  timing_.water_ms = std::chrono::duration<double, std::milli>(t1 - t0).count() - rain_step_ms;
+  timing_.road_ms = road_ms_;
+  timing_.water_ms =
+      std::chrono::duration<double, std::milli>(t1 - t0).count() - rain_step_ms - road_ms_;
   timing_.publish_ms = std::chrono::duration<double, std::milli>(Clock::now() - t1).count() -
                        (rain_ms_ - rain_step_ms);
 }
@@ -93,6 +119,14 @@ void Simulation::sub_step() {
   rain_.advance(config_.sub_step_s, state_.sim_time_s, state_.weather, state_.vehicle);
   rain_ms_ +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (config_.simulate_road && ++sub_steps_since_road_ >= config_.sub_steps_per_road_step) {
+    const auto r0 = std::chrono::steady_clock::now();
+    road_.step(glm::dvec2(state_.vehicle.position_m), state_.weather.rain_rate_mm_h,
+               sub_steps_since_road_ * config_.sub_step_s);
+    sub_steps_since_road_ = 0;
+    road_ms_ +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0).count();
+  }
   if (!config_.simulate_water ||
       ++sub_steps_since_water_ < config_.windshield.sub_steps_per_water_step) {
     return;

@@ -1,5 +1,5 @@
 // One session's deterministic world: the simulator's inputs and the clock, advanced in fixed
-// sub-steps. Later issues add the windshield water, rain and road water here.
+// sub-steps: the windshield's water, the rain in the air and the water on the road.
 #pragma once
 
 #include <array>
@@ -9,6 +9,7 @@
 
 #include "server/sim/glass_water_map.hpp"
 #include "server/sim/rain_field.hpp"
+#include "server/sim/road_water.hpp"
 #include "server/sim/types.hpp"
 #include "server/sim/water.hpp"
 #include "server/sim/windshield.hpp"
@@ -22,6 +23,7 @@ struct AdvanceTiming {
   double water_ms = 0.0;    // the windshield water's sub-steps
   double publish_ms = 0.0;  // the metaballs and the glass water map
   double rain_ms = 0.0;     // the rain in the air: its steps and its copy for the renderer
+  double road_ms = 0.0;     // the water on the road's steps
 };
 
 struct SimulationConfig {
@@ -29,7 +31,10 @@ struct SimulationConfig {
   WindshieldConfig windshield;
   GlassWaterMapConfig water_map;
   RainFieldConfig rain;
-  bool simulate_water = true;  // false: the glass stays dry (tools and tests of other effects)
+  RoadWaterConfig road;
+  int sub_steps_per_road_step = 8;  // 1/30 s: the road's water changes over seconds
+  bool simulate_water = true;       // false: the glass stays dry (tools and tests of other effects)
+  bool simulate_road = true;        // false: the road stays dry
 };
 
 // What the renderer reads: a copy, taken on the render thread after a step.
@@ -42,8 +47,9 @@ struct SceneState {
   Weather weather;
   std::vector<TrafficVehicle> traffic;
   GlassConfig glass;
-  WindshieldState windshield;  // published once per advance(), not per sub-step
-  RainState rain;              // likewise
+  WindshieldState windshield;             // published once per advance(), not per sub-step
+  RainState rain;                         // likewise
+  std::array<TireWater, kTires> tires{};  // the road's water under the ego car's tires, likewise
 };
 
 class Simulation {
@@ -61,6 +67,7 @@ class Simulation {
   const WaterSim& water() const { return water_; }
   const RainField& rain() const { return rain_; }
   const GlassWaterMapBuilder& water_map() const { return water_map_; }
+  const RoadWater& road() const { return road_; }
   const AdvanceTiming& last_advance_timing() const { return timing_; }
   // The relative air (wind minus the car's velocity) in the vehicle frame, m/s.
   glm::dvec3 air_velocity_vehicle() const;
@@ -80,8 +87,14 @@ class Simulation {
   GlassWaterMapBuilder water_map_;
   std::array<BladePose, 2> blades_at_water_step_;
   int sub_steps_since_water_ = 0;
+  // The road's relief from the seed (on the heap: the road water refers to it wherever the
+  // simulation moves), and its water.
+  std::unique_ptr<RoadSurface> surface_;
+  RoadWater road_;
+  int sub_steps_since_road_ = 0;
   AdvanceTiming timing_;
   double rain_ms_ = 0.0;  // the rain field's time in this advance, so far
+  double road_ms_ = 0.0;  // the road water's, likewise
 };
 
 }  // namespace downpour::sim

@@ -52,6 +52,23 @@ struct TrafficVehicle {
   glm::dvec3 size_m{4.5, 1.8, 1.5};
 };
 
+// The road's state under a point (road_water.hpp).
+enum class RoadState : std::uint8_t {
+  kDry,     // no water to speak of
+  kWet,     // water in the surface's texture, little or none standing
+  kDrench,  // a film standing on the surface
+  kPuddle,  // standing water at least RoadWaterConfig::puddle_m deep
+};
+
+// The water under one of the ego car's tires after a step: what a driving simulator needs for
+// aquaplaning and grip.
+struct TireWater {
+  double water_mm = 0.0;     // all the water on the road there (in the texture and standing)
+  double standing_mm = 0.0;  // the part standing above the texture
+  RoadState state = RoadState::kDry;
+};
+inline constexpr int kTires = 4;  // front left, front right, rear left, rear right
+
 // A partial update: what is present is applied, what is absent keeps its value.
 struct Update {
   double client_time_s = 0.0;

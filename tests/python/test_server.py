@@ -319,6 +319,36 @@ class ServerTest(ServerProcessCase):
         self.assertGreater(cockpit.visibility_m, 1000.0)
         self.assertLess(cockpit.visibility_m, 2000.0)
 
+    def test_frames_report_the_water_under_the_tires(self):
+        def standing_in(rain_mm_h):
+            update = pb.Update(sim_time_s=0.0)
+            update.vehicle.position_m.x = 100.0
+            update.vehicle.position_m.y = -1.75  # the inner lane, on the right
+            update.weather.rain_rate_mm_h = rain_mm_h
+            return update
+        tires = {}
+        for rain in (0.0, 200.0):
+            info = self.client.create_session([view_spec("ROAD", 64, 36)], seed=7,
+                                              initial=standing_in(rain))
+            self.addCleanup(self._close_quietly, info.session_id)
+            for step in range(1, 5):  # 20 s
+                update = standing_in(rain)
+                update.sim_time_s = 5.0 * step
+                frames = self.client.step(info.session_id, 5.0, update)
+            tires[rain] = frames[0].tires
+        self.assertEqual(len(tires[0.0]), 4)
+        for tire in tires[0.0]:
+            self.assertEqual(tire.state, pb.ROAD_DRY)
+            self.assertEqual(tire.water_mm, 0.0)
+        # 20 s of a cloudburst: 1.1 mm fell; the asphalt's texture holds 0.5 mm, the rest stands
+        # and runs off across the crown, with what comes down from the crown's side.
+        self.assertEqual(len(tires[200.0]), 4)
+        for tire in tires[200.0]:
+            self.assertGreater(tire.water_mm, 0.5)
+            self.assertLess(tire.water_mm, 3.0)
+            self.assertGreaterEqual(tire.standing_mm, 0.0)
+            self.assertIn(tire.state, (pb.ROAD_WET, pb.ROAD_DRENCH, pb.ROAD_PUDDLE))
+
     def test_realtime_frames_stream_to_a_watcher(self):
         session_id = self.open_session(views=[VIEWS[0]], mode=pb.MODE_REALTIME, fps=20)
         call = self.client.watch_frames(session_id)
