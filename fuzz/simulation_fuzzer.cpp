@@ -3,7 +3,8 @@
 // simulation advanced by its dt_s (capped at 0.2 s per input, and on a coarse water map, so that
 // one input stays quick: the same code at a quarter of the resolution). After every step the state
 // must be finite and the water must be accounted for: what arrived on the glass is on it, wiped
-// off, drained or evaporated; the rain in the air stays bounded and finite.
+// off, drained or evaporated; the rain in the air stays bounded and finite; the road's water is
+// finite and its ledger closes.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -56,6 +57,15 @@ void check(const sim::Simulation& simulation) {
     require(s.diameter_mm >= rain.config().smallest_drawn_mm - 1e-6 &&
             s.diameter_mm <= rain.config().max_diameter_mm + 1e-6);
   }
+  // The water on the road: finite, and every cubic metre accounted for.
+  const sim::RoadWater& road = simulation.road();
+  const sim::RoadWater::Ledger& rl = road.ledger();
+  const double stored = road.stored_m3();
+  require(std::isfinite(stored) && stored >= -1e-9);
+  require(std::abs(stored + rl.drained_m3 + rl.evaporated_m3 + rl.thrown_m3 - rl.rain_in_m3) <=
+          1e-9 * std::max(1.0, rl.rain_in_m3));
+  for (const sim::TireWater& t : simulation.state().tires)
+    require(std::isfinite(t.water_mm) && t.water_mm >= -1e-9 && t.standing_mm >= 0.0);
   for (const auto& d : water.drops()) {
     if (!d.alive) continue;
     require(std::isfinite(d.pos.x) && std::isfinite(d.pos.y) && std::isfinite(d.mass));

@@ -28,7 +28,7 @@ Simulation::Simulation(std::uint64_t seed, const Update& initial, SimulationConf
       rain_(seed, config.rain),
       water_map_(config.windshield.glass, config.water_map),
       blades_at_water_step_(wipers_.poses()),
-      surface_(std::make_unique<RoadSurface>(test_track(), seed)),
+      surface_(std::make_shared<const RoadSurface>(test_track(), seed)),
       road_(*surface_, config.road) {
   state_.glass = config_.windshield.glass;
   apply(initial);

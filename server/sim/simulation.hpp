@@ -87,9 +87,9 @@ class Simulation {
   GlassWaterMapBuilder water_map_;
   std::array<BladePose, 2> blades_at_water_step_;
   int sub_steps_since_water_ = 0;
-  // The road's relief from the seed (on the heap: the road water refers to it wherever the
-  // simulation moves), and its water.
-  std::unique_ptr<RoadSurface> surface_;
+  // The road's relief from the seed, shared by copies of the simulation (it never changes; the
+  // road water refers to it wherever a simulation is moved or copied), and its water.
+  std::shared_ptr<const RoadSurface> surface_;
   RoadWater road_;
   int sub_steps_since_road_ = 0;
   AdvanceTiming timing_;
