@@ -147,8 +147,13 @@ void RoadWater::move_to(glm::ivec2 origin) {
     }
   }
   // The rest move to their new places; the new ones are filled.
-  std::vector<double> ground(ground_.size()), water(water_.size());
-  std::vector<std::uint8_t> paved(paved_.size());
+  // Into the spare arrays (made once), then swapped in.
+  std::vector<double>& ground = spare_ground_;
+  std::vector<double>& water = spare_water_;
+  std::vector<std::uint8_t>& paved = spare_paved_;
+  ground.assign(ground_.size(), 0.0);
+  water.assign(water_.size(), 0.0);
+  paved.assign(paved_.size(), 0);
   for (int j = 0; j < n_; ++j) {
     for (int i = 0; i < n_; ++i) {
       const glm::ivec2 old = glm::ivec2(i, j) + shift;

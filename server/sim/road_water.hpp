@@ -109,9 +109,11 @@ class RoadWater {
   double dry_time_s_ = 0.0;  // time stepped without rain: the records evaporate by it
   std::vector<double> ground_, water_;
   std::vector<std::uint8_t> paved_;
-  std::vector<double> outflow_, flow_x_, flow_y_;  // one step's flows (m^3), made once
-  std::map<Key, Record> records_;                  // coarse, by record_m squares
-  std::map<Key, Record> puddle_cells_;             // by cell: a puddle's water (cells_out unused)
+  std::vector<double> outflow_, flow_x_, flow_y_;   // one step's flows (m^3), made once
+  std::vector<double> spare_ground_, spare_water_;  // move_to's, made once
+  std::vector<std::uint8_t> spare_paved_;
+  std::map<Key, Record> records_;       // coarse, by record_m squares
+  std::map<Key, Record> puddle_cells_;  // by cell: a puddle's water (cells_out unused)
   Ledger ledger_;
 };
 
