@@ -286,8 +286,6 @@ double RoadWater::standing_m(glm::dvec2 xy) const {
   return std::max(water_m(xy) - config_.capacity_m, 0.0);
 }
 
-RoadState RoadWater::state(glm::dvec2 xy) const { return state_of(water_m(xy)); }
-
 double RoadWater::take(glm::dvec2 xy, double volume_m3) {
   const int c = index(xy);
   if (c < 0 || !(volume_m3 > 0.0)) return 0.0;

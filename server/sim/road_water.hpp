@@ -49,11 +49,10 @@ class RoadWater {
   // Centres the window on `centre` (world, m), then advances dt_s under rain_mm_h.
   void step(glm::dvec2 centre, double rain_mm_h, double dt_s);
 
-  // At a world position in the window (else 0 and kDry): all water on the surface (m of depth),
-  // the part standing above the texture, and the state.
+  // At a world position in the window (else 0): all water on the surface (m of depth),
+  // and the part standing above the texture (state_of gives the state).
   double water_m(glm::dvec2 xy) const;
   double standing_m(glm::dvec2 xy) const;
-  RoadState state(glm::dvec2 xy) const;
   // Takes up to volume_m3 from the cell at xy (spray); returns what it took.
   double take(glm::dvec2 xy, double volume_m3);
 
