@@ -296,6 +296,48 @@ double RoadWater::take(glm::dvec2 xy, double volume_m3) {
   return taken;
 }
 
+void RoadWater::image(RoadWaterImage& out) const {
+  out.origin = origin_;
+  out.cell_m = config_.cell_m;
+  out.cells = n_;
+  out.capacity_mm = config_.capacity_m * 1e3;
+  out.water_standing_mm.resize(water_.size() * 2);
+  out.max_standing_mm = 0.0f;
+  double water_sum = 0.0, standing_sum = 0.0;
+  int paved = 0;
+  for (std::size_t c = 0; c < water_.size(); ++c) {
+    const double standing = std::max(water_[c] - config_.capacity_m, 0.0);
+    out.water_standing_mm[2 * c] = static_cast<float>(water_[c] * 1e3);
+    out.water_standing_mm[2 * c + 1] = static_cast<float>(standing * 1e3);
+    out.max_standing_mm = std::max(out.max_standing_mm, static_cast<float>(standing * 1e3));
+    if (paved_[c]) {
+      water_sum += water_[c];
+      standing_sum += standing;
+      ++paved;
+    }
+  }
+  // An unpaved cell beside the road shows the water of its paved neighbours, so that the road's
+  // edge, drawn smooth, never shows the cells' steps (the verge draws its own wetness).
+  for (int j = 0; j < n_; ++j) {
+    for (int i = 0; i < n_; ++i) {
+      const std::size_t c = static_cast<std::size_t>(j) * n_ + i;
+      if (paved_[c]) continue;
+      for (const auto& [di, dj] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
+        if (i + di < 0 || i + di >= n_ || j + dj < 0 || j + dj >= n_) continue;
+        const std::size_t d = static_cast<std::size_t>(j + dj) * n_ + i + di;
+        if (!paved_[d]) continue;
+        out.water_standing_mm[2 * c] =
+            std::max(out.water_standing_mm[2 * c], static_cast<float>(water_[d] * 1e3));
+        out.water_standing_mm[2 * c + 1] =
+            std::max(out.water_standing_mm[2 * c + 1],
+                     static_cast<float>(std::max(water_[d] - config_.capacity_m, 0.0) * 1e3));
+      }
+    }
+  }
+  out.mean_water_mm = paved > 0 ? static_cast<float>(water_sum / paved * 1e3) : 0.0f;
+  out.mean_standing_mm = paved > 0 ? static_cast<float>(standing_sum / paved * 1e3) : 0.0f;
+}
+
 double RoadWater::stored_m3() const {
   double sum = 0.0;
   for (const double w : water_) sum += w;

@@ -21,6 +21,21 @@
 
 namespace downpour::sim {
 
+// The window's water as the renderer draws it: per cell, rows along +y, the water on the surface
+// and the part of it standing above the texture, both in mm (floats, 2 per cell).
+struct RoadWaterImage {
+  glm::ivec2 origin{0};  // the window's lower-left cell in the world's grid (RoadWater::origin)
+  double cell_m = 0.25;
+  int cells = 0;  // per side
+  double capacity_mm = 0.5;
+  std::vector<float> water_standing_mm;
+  float max_standing_mm = 0.0f;
+  // Over the paved cells: what the road beyond the window is drawn with, until coarser rings hold
+  // it.
+  float mean_water_mm = 0.0f;
+  float mean_standing_mm = 0.0f;
+};
+
 struct RoadWaterConfig {
   // S0: a drop's wet spot is a centimetre or two; cells that small around a car would be millions,
   // so the finest cell is a quarter of a metre, finer than a rut (0.7 m wide) or a bowl.
@@ -77,6 +92,8 @@ class RoadWater {
   const std::vector<double>& water() const { return water_; }
   const std::vector<std::uint8_t>& paved() const { return paved_; }
   RoadState state_of(double water_m) const;
+  // The window as the renderer draws it.
+  void image(RoadWaterImage& out) const;
 
  private:
   struct Record {

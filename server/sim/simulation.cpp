@@ -43,6 +43,12 @@ void Simulation::publish() {
   rain_ms_ +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   state_.windshield.glass_wet_fraction = state_.windshield.map.wet_fraction;
+  if (road_steps_ != road_steps_published_ || !state_.road_water) {
+    auto image = std::make_shared<RoadWaterImage>();
+    road_.image(*image);
+    state_.road_water = std::move(image);
+    road_steps_published_ = road_steps_;
+  }
   // Under each tire: front left, front right, rear left, rear right.
   const glm::dmat4 to_world = vehicle_to_world(state_.vehicle);
   for (int t = 0; t < kTires; ++t) {
@@ -97,6 +103,9 @@ SceneState Simulation::inputs_after(double dt_s) const {
   inputs.weather = state_.weather;
   inputs.traffic = state_.traffic;
   inputs.glass = state_.glass;
+  // The road's water as the last step left it (it changes over seconds; the step may be running
+  // while the road is drawn).
+  inputs.road_water = state_.road_water;
   inputs.sub_steps = state_.sub_steps;
   for (double carry = carry_s_ + dt_s; whole_sub_step_due(carry); carry -= config_.sub_step_s)
     ++inputs.sub_steps;
@@ -124,6 +133,7 @@ void Simulation::sub_step() {
     road_.step(glm::dvec2(state_.vehicle.position_m), state_.weather.rain_rate_mm_h,
                sub_steps_since_road_ * config_.sub_step_s);
     sub_steps_since_road_ = 0;
+    ++road_steps_;
     road_ms_ +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0).count();
   }

@@ -50,6 +50,9 @@ struct SceneState {
   WindshieldState windshield;             // published once per advance(), not per sub-step
   RainState rain;                         // likewise
   std::array<TireWater, kTires> tires{};  // the road's water under the ego car's tires, likewise
+  // The road's water around the car, for drawing; shared by copies, replaced after each road
+  // step (null before the first).
+  std::shared_ptr<const RoadWaterImage> road_water;
 };
 
 class Simulation {
@@ -92,6 +95,8 @@ class Simulation {
   std::shared_ptr<const RoadSurface> surface_;
   RoadWater road_;
   int sub_steps_since_road_ = 0;
+  std::uint64_t road_steps_ = 0;
+  std::uint64_t road_steps_published_ = 0;
   AdvanceTiming timing_;
   double rain_ms_ = 0.0;  // the rain field's time in this advance, so far
   double road_ms_ = 0.0;  // the road water's, likewise

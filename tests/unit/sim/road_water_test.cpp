@@ -1,9 +1,11 @@
 // The water on the road: every cubic metre accounted for over ten minutes of heavy rain on the
 // move; puddles in ruts, bowls and at the edge, never on the crown's top; a cell walks Dry, Wet,
 // Drench, Puddle as water rises; puddles shrink once the rain stops; water stays where it fell
-// when the car drives away and back; the same inputs give the same water.
+// when the car drives away and back; the same inputs give the same water; the renderer's image of
+// the window.
 #include "server/sim/road_water.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -196,6 +198,40 @@ TEST_F(RoadWaterTest, TheSameInputsGiveTheSameWater) {
   }
   EXPECT_EQ(a.water(), b.water());
   EXPECT_NE(a.water(), c.water());
+}
+
+TEST_F(RoadWaterTest, TheImageForTheRendererIsTheWindowInMillimetres) {
+  RoadWaterConfig config;
+  config.cells = 96;  // 24 m: past the right edge of the road
+  RoadWater water(surface, config);
+  for (int k = 0; k < 600; ++k) water.step(at(250.0, -1.75), 30.0, 0.1);  // a minute of 30 mm/h
+  RoadWaterImage image;
+  water.image(image);
+  const int n = water.cells();
+  ASSERT_EQ(image.cells, n);
+  EXPECT_EQ(image.origin, water.origin());
+  ASSERT_EQ(image.water_standing_mm.size(), static_cast<std::size_t>(n) * n * 2);
+  double sum = 0.0, max_standing = 0.0;
+  int paved = 0, edge = 0;
+  for (int c = 0; c < n * n; ++c) {
+    const double w = water.water()[c] * 1e3;
+    const double standing = std::max(w - config.capacity_m * 1e3, 0.0);
+    if (water.paved()[c]) {
+      EXPECT_NEAR(image.water_standing_mm[2 * c], w, 1e-4 * (1.0 + w));
+      EXPECT_NEAR(image.water_standing_mm[2 * c + 1], standing, 1e-4 * (1.0 + standing));
+      sum += w;
+      max_standing = std::max(max_standing, standing);
+      ++paved;
+    } else if (image.water_standing_mm[2 * c] > 0.0f) {
+      ++edge;  // beside the road: its neighbours' water, so that the road's edge draws smooth
+      EXPECT_EQ(water.water()[c], 0.0);
+    }
+  }
+  ASSERT_GT(paved, 0);
+  EXPECT_GT(edge, 0);
+  EXPECT_NEAR(image.mean_water_mm, sum / paved, 1e-4 * sum / paved);
+  EXPECT_NEAR(image.max_standing_mm, max_standing, 1e-4 * (1.0 + max_standing));
+  EXPECT_GT(image.mean_water_mm, 0.25);  // a minute of 30 mm/h is 0.5 mm
 }
 
 }  // namespace

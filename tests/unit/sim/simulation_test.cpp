@@ -87,6 +87,24 @@ TEST(SimulationTest, InputsAfterAStepAreItsStateButTheWater) {
   }
 }
 
+TEST(SimulationTest, EachRoadStepPublishesANewImageOfTheRoadsWater) {
+  const Scenario scenario = highway_heavy_rain();
+  Simulation sim(scenario.seed, scenario.at(3.0));
+  ASSERT_NE(sim.state().road_water, nullptr);  // (dry, before the first step)
+  sim.advance(1.0);
+  const auto image = sim.state().road_water;
+  ASSERT_NE(image, nullptr);
+  EXPECT_EQ(image->cells, sim.road().cells());
+  EXPECT_EQ(image->origin, sim.road().origin());
+  EXPECT_GT(image->mean_water_mm, 0.0f);
+  // What is drawn while the next step runs: the image the last one left.
+  EXPECT_EQ(sim.inputs_after(1.0 / 30.0).road_water, image);
+  sim.advance(1.0 / 240.0);  // no road step: the same image
+  EXPECT_EQ(sim.state().road_water, image);
+  sim.advance(1.0 / 30.0);
+  EXPECT_NE(sim.state().road_water, image);
+}
+
 TEST(SimulationTest, ConfiguredSubStep) {
   SimulationConfig config;
   config.sub_step_s = 0.01;
