@@ -11,6 +11,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <ctime>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -27,6 +28,7 @@
 #include "server/session/frame_scheduler.hpp"
 #include "server/session/session_registry.hpp"
 #include "server/sim/scenario.hpp"
+#include "tests/render/road_water_fixture.hpp"
 
 namespace {
 
@@ -73,7 +75,8 @@ constexpr Ceiling kCeilings[] = {
     {"glass_composite", 0.7, "windshield: over the view, and the blades"},
     {"rain", 0.0, "rain streaks and splashes (the CPU layer and its composite)"},
     {"rain_layer", -1.0, "rain: the CPU layer alone (part of rain)"},
-    {"wet_road", 4.0, "wet road, puddles, reflections (to come)"},
+    {"road_reflection", -1.0, "wet road: the scene mirrored in the road (part of wet_road)"},
+    {"wet_road", 4.0, "wet road, puddles, reflections: its share of the COCKPIT frame"},
     {"spray", 6.0, "tyre spray (to come)"},
     {"relief_shadows", 1.5, "relief shadows (to come)"},
     {"lights", 3.0, "lights (to come)"},
@@ -155,9 +158,10 @@ json measure_stages(const sim::Scenario& scenario, const sim::ViewSpec& spec, in
 // Each pass's median, from a renderer that finishes the GPU's work after every pass. Finishing
 // mid-frame splits llvmpipe's binned scene, which makes every later frame of that context slower,
 // so these times rank the passes and add up to more than render_thread_ms above, the frame's
-// real cost.
+// real cost. `vary`, where given, makes the state drawn from the simulated one.
 json measure_passes(const sim::Scenario& scenario, const sim::ViewSpec& spec, int frames,
-                    double warm_s) {
+                    double warm_s,
+                    const std::function<sim::SceneState(const sim::SceneState&)>& vary = {}) {
   auto renderer = render::Renderer::create(g_renderer);
   renderer->set_profiling(true);
   auto targets = renderer->open_session();
@@ -170,7 +174,8 @@ json measure_passes(const sim::Scenario& scenario, const sim::ViewSpec& spec, in
   for (int i = 0; i < frames + 3; ++i) {
     simulation.apply(scenario.at(simulation.state().sim_time_s + dt));
     simulation.advance(dt);
-    renderer->finish(renderer->render(*targets, 0, spec, simulation.state()), pixels);
+    const sim::SceneState drawn = vary ? vary(simulation.state()) : simulation.state();
+    renderer->finish(renderer->render(*targets, 0, spec, drawn), pixels);
     if (i < 3) continue;
     for (const auto& p : renderer->last_pass_timings()) passes[p.name].push_back(p.ms);
     streaks.push_back(renderer->last_rain_streaks());
@@ -181,12 +186,14 @@ json measure_passes(const sim::Scenario& scenario, const sim::ViewSpec& spec, in
   return j;
 }
 
-// What the rain adds to a whole frame (no finish between passes, as the server renders): each
-// frame rendered with its rain and again without (no drops, no splashes), in turn, and the median
-// of the differences. Pass times, with a finish after each, overstate a full-view pass on llvmpipe
-// (each finish makes the next pass load and store the whole target again).
-double rain_in_frame_ms(const sim::Scenario& scenario, const sim::ViewSpec& spec, int frames,
-                        double warm_s) {
+// What an effect adds to a whole frame (no finish between passes, as the server renders): each
+// frame rendered with the effect and again without (`variants` makes the two from the simulated
+// state), in turn, and the median of the differences. Pass times, with a finish after each,
+// overstate a full-view pass on llvmpipe (each finish makes the next pass load and store the whole
+// target again).
+using Variants = std::function<std::pair<sim::SceneState, sim::SceneState>(const sim::SceneState&)>;
+double added_in_frame_ms(const sim::Scenario& scenario, const sim::ViewSpec& spec, int frames,
+                         double warm_s, const Variants& variants) {
   auto renderer = render::Renderer::create(g_renderer);
   auto targets = renderer->open_session();
   sim::Simulation simulation(scenario.seed, scenario.at(0.0));
@@ -202,23 +209,68 @@ double rain_in_frame_ms(const sim::Scenario& scenario, const sim::ViewSpec& spec
   for (int i = 0; i < frames + 3; ++i) {
     simulation.apply(scenario.at(simulation.state().sim_time_s + dt));
     simulation.advance(dt);
-    sim::SceneState dry = simulation.state();
-    dry.rain.drops.clear();
-    dry.rain.splashes.clear();
+    const auto [with_effect, without_effect] = variants(simulation.state());
     // The new state's first render uploads its glass water map: untimed, so that neither of
     // the two timed ones pays for it; and the two in turn, first one then the other.
-    frame_ms(dry);
+    frame_ms(without_effect);
     double with = 0.0, without = 0.0;
     if (i % 2 == 0) {
-      with = frame_ms(simulation.state());
-      without = frame_ms(dry);
+      with = frame_ms(with_effect);
+      without = frame_ms(without_effect);
     } else {
-      without = frame_ms(dry);
-      with = frame_ms(simulation.state());
+      without = frame_ms(without_effect);
+      with = frame_ms(with_effect);
     }
     if (i >= 3) added.push_back(with - without);
   }
   return median(added);
+}
+
+// The rain's share: the frame with its rain, and without (no drops, no splashes).
+double rain_in_frame_ms(const sim::Scenario& scenario, const sim::ViewSpec& spec, int frames,
+                        double warm_s) {
+  return added_in_frame_ms(scenario, spec, frames, warm_s, [](const sim::SceneState& state) {
+    sim::SceneState dry = state;
+    dry.rain.drops.clear();
+    dry.rain.splashes.clear();
+    return std::pair{state, dry};
+  });
+}
+
+// The wet road (README, Frame budget) in COCKPIT and ROAD at 640 x 360: its share of whole frames
+// (the road with a 0.3 mm film and the render tests' puddles, hand-made so that every run draws the
+// same water, against a dry road; no rain in the air in either, so that the reflection is drawn
+// for the road's water alone), and its passes with a finish after each: the reflection and the
+// road's own.
+json measure_wet_road(const sim::Scenario& scenario, int frames, double warm_s) {
+  auto road = [](const sim::SceneState& state, double film_mm) {
+    sim::SceneState s = state;
+    s.weather.rain_rate_mm_h = 0.0;
+    s.rain.drops.clear();
+    s.rain.splashes.clear();
+    s.road_water = testing::hand_road_water(
+        s.vehicle, film_mm,
+        film_mm > 0.0 ? testing::test_puddles() : std::vector<testing::HandPuddle>{});
+    return s;
+  };
+  json rows = json::array();
+  for (const sim::View view : {sim::View::kCockpit, sim::View::kRoad}) {
+    const sim::ViewSpec spec = sim::view_spec(view, 640, 360);
+    const json passes =
+        measure_passes(scenario, spec, frames, warm_s,
+                       [&](const sim::SceneState& state) { return road(state, 0.3); });
+    json row = {{"view", std::string(sim::view_name(view))}, {"size", "640x360"}};
+    // Terrain, drawn the same in both, to compare runs on machines of different speeds.
+    for (const char* name : {"road_reflection", "road", "terrain"})
+      row[std::string(name) + "_ms"] = passes.value(name, 0.0);
+    row["wet_road_in_frame_ms"] =
+        added_in_frame_ms(scenario, spec, frames, warm_s, [&](const sim::SceneState& state) {
+          return std::pair{road(state, 0.3), road(state, 0.0)};
+        });
+    row["ceiling_ms"] = 4.0;
+    rows.push_back(row);
+  }
+  return rows;
 }
 
 // The rain pass at the streak counts (README, Frame budget): streaks drawn in the view,
@@ -375,6 +427,7 @@ int main(int argc, char** argv) {
   double fps = 0.0;
   bool check_renderer = false;
   bool rain_only = false;
+  bool wet_road_only = false;
   const std::map<std::string, render::EglPlatformChoice> renderers{
       {"auto", render::EglPlatformChoice::kAuto},
       {"device", render::EglPlatformChoice::kDevice},
@@ -396,6 +449,8 @@ int main(int argc, char** argv) {
                "print the renderer the server would use and exit: 0 if a GPU's EGL device");
   app.add_flag("--rain-only", rain_only,
                "only the rain pass at 10,000 and 80,000 streaks (the rain rows of the table)");
+  app.add_flag("--wet-road-only", wet_road_only,
+               "only the wet road in COCKPIT and ROAD (the wet road's row of the table)");
   CLI11_PARSE(app, argc, argv);
 
   if (check_renderer) {
@@ -420,7 +475,7 @@ int main(int argc, char** argv) {
   out["encoder_threads"] = g_encoder_threads;
   out["hardware_threads"] = std::thread::hardware_concurrency();
   std::map<std::string, json> pass_ms;  // by size
-  if (rain_only) sizes.clear();
+  if (rain_only || wet_road_only) sizes.clear();
   for (const std::string& size : sizes) {
     int width = 0, height = 0;
     if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16) {
@@ -455,8 +510,11 @@ int main(int argc, char** argv) {
     out["results"].push_back(r);
     std::fprintf(stderr, "%s done\n", size.c_str());
   }
-  out["rain"] = measure_rain(scenario, std::min(frames, 30), std::min(warm_s, 2.0));
-  if (demo && !rain_only) {
+  if (!wet_road_only)
+    out["rain"] = measure_rain(scenario, std::min(frames, 30), std::min(warm_s, 2.0));
+  if (!rain_only)
+    out["wet_road"] = measure_wet_road(scenario, std::min(frames, 30), std::min(warm_s, 2.0));
+  if (demo && !rain_only && !wet_road_only) {
     const std::vector<sim::ViewSpec> views = {sim::view_spec(sim::View::kCockpit, 640, 360),
                                               sim::view_spec(sim::View::kRoad, 640, 360)};
     out["demo"] = measure_realtime(scenario, views, realtime_s, warm_s);
@@ -473,6 +531,8 @@ int main(int argc, char** argv) {
     for (const auto& [size, passes] : pass_ms) {
       row["ms_" + size] = passes.contains(c.pass) ? json(passes[c.pass]) : json(nullptr);
     }
+    if (std::string(c.pass) == "wet_road" && out.contains("wet_road"))
+      row["ms_640x360"] = out["wet_road"][0]["wet_road_in_frame_ms"];
     out["budget"].push_back(row);
   }
   std::printf("%s\n", out.dump(2).c_str());

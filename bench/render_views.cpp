@@ -4,6 +4,8 @@
 //     [rain_rate_mm_h] [--windshield N] [--blades A B] [--dash] [--measure FRAMES] [--wipe]
 //     [--speed MPS]
 // --speed MPS: the car's speed along its heading (0: standing), in place of the scene's.
+// --road-water FILM_MM: a hand-made road (tests/render/road_water_fixture.hpp): a film of FILM_MM
+//   over the paved width (0: dry), and with --puddles the render tests' puddles ahead of the car.
 // --windshield N: a hand-made rainy windshield (tests/render/windshield_fixture.hpp) of about N
 //   metaballs instead of the simulation's, with the wiper blades at A and B degrees from +u
 //   (--blades; default 40 36); N = 0: the render tests' golden windshield. --dash: also the COCKPIT
@@ -32,6 +34,7 @@
 #include "server/render/view_wet_fraction.hpp"
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"
+#include "tests/render/road_water_fixture.hpp"
 #include "tests/render/windshield_fixture.hpp"
 #include "tests/support/png_io.hpp"
 
@@ -99,6 +102,8 @@ int main(int argc, char** argv) {
   int measure_frames = 0;
   bool wipe = false;
   double speed = -1.0;
+  double road_film_mm = -1.0;
+  bool puddles = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--windshield" && i + 1 < argc) {
@@ -110,6 +115,10 @@ int main(int argc, char** argv) {
       dash = true;
     } else if (arg == "--wipe") {
       wipe = true;
+    } else if (arg == "--road-water" && i + 1 < argc) {
+      road_film_mm = std::atof(argv[++i]);
+    } else if (arg == "--puddles") {
+      puddles = true;
     } else if (arg == "--speed" && i + 1 < argc) {
       speed = std::atof(argv[++i]);
     } else if (arg == "--measure" && i + 1 < argc) {
@@ -148,6 +157,11 @@ int main(int argc, char** argv) {
     scene.windshield = testing::golden_windshield(scene.glass);
   } else if (windshield_metaballs > 0) {
     scene.windshield = testing::rainy_windshield(scene.glass, windshield_metaballs, blades);
+  }
+  if (road_film_mm >= 0.0) {
+    scene.road_water = testing::hand_road_water(
+        scene.vehicle, road_film_mm,
+        puddles ? testing::test_puddles() : std::vector<testing::HandPuddle>{});
   }
   std::printf("windshield: %zu metaballs, glass wet fraction %.3f\n",
               scene.windshield.metaballs.size(), scene.windshield.glass_wet_fraction);

@@ -15,4 +15,7 @@ void main() {
   v_uv = a_uv;
   v_fog = fog_at(world.xyz);
   gl_Position = frame.view_proj * world;
+  // The road reflection keeps what is above the road; other frames' plane keeps everything (a
+  // distance written is a distance used on llvmpipe, enabled or not).
+  gl_ClipDistance[0] = dot(frame.clip_plane.xyz, world.xyz) + frame.clip_plane.w;
 }

@@ -26,12 +26,13 @@ ChunkedMesh::ChunkedMesh(const std::vector<std::vector<MeshData>>& chunks,
 
 template <typename Fn>
 void ChunkedMesh::for_each_visible(const glm::mat4& view_proj, const glm::vec3& camera,
-                                   Fn&& fn) const {
+                                   float distance_scale, Fn&& fn) const {
   for (const Chunk& chunk : chunks_) {
     if (chunk.levels.empty() || !box_visible(view_proj, chunk.bounds_min, chunk.bounds_max))
       continue;
     const float distance =
-        glm::length(glm::clamp(camera, chunk.bounds_min, chunk.bounds_max) - camera);
+        glm::length(glm::clamp(camera, chunk.bounds_min, chunk.bounds_max) - camera) *
+        distance_scale;
     std::size_t level = 0;
     while (level < level_distances_m_.size() && level + 1 < chunk.levels.size() &&
            distance >= level_distances_m_[level]) {
@@ -41,14 +42,16 @@ void ChunkedMesh::for_each_visible(const glm::mat4& view_proj, const glm::vec3& 
   }
 }
 
-void ChunkedMesh::draw_visible(const glm::mat4& view_proj, const glm::vec3& camera) const {
-  for_each_visible(view_proj, camera, [](const Mesh& mesh) { mesh.draw(); });
+void ChunkedMesh::draw_visible(const glm::mat4& view_proj, const glm::vec3& camera,
+                               float distance_scale) const {
+  for_each_visible(view_proj, camera, distance_scale, [](const Mesh& mesh) { mesh.draw(); });
 }
 
 std::size_t ChunkedMesh::visible_triangles(const glm::mat4& view_proj,
                                            const glm::vec3& camera) const {
   std::size_t triangles = 0;
-  for_each_visible(view_proj, camera, [&](const Mesh& mesh) { triangles += mesh.triangles(); });
+  for_each_visible(view_proj, camera, 1.0f,
+                   [&](const Mesh& mesh) { triangles += mesh.triangles(); });
   return triangles;
 }
 

@@ -18,14 +18,17 @@ class ChunkedMesh {
   // at least level_distances_m[k - 1] from the camera.
   ChunkedMesh(const std::vector<std::vector<MeshData>>& chunks,
               std::vector<float> level_distances_m);
-  // Draws the chunks whose bounds meet the view's frustum with the bound program.
-  void draw_visible(const glm::mat4& view_proj, const glm::vec3& camera) const;
+  // Draws the chunks whose bounds meet the view's frustum with the bound program, each at the
+  // level for its distance times distance_scale.
+  void draw_visible(const glm::mat4& view_proj, const glm::vec3& camera,
+                    float distance_scale = 1.0f) const;
   // The triangles draw_visible() would draw (for tests and benchmarks).
   std::size_t visible_triangles(const glm::mat4& view_proj, const glm::vec3& camera) const;
 
  private:
   template <typename Fn>
-  void for_each_visible(const glm::mat4& view_proj, const glm::vec3& camera, Fn&& fn) const;
+  void for_each_visible(const glm::mat4& view_proj, const glm::vec3& camera, float distance_scale,
+                        Fn&& fn) const;
 
   struct Chunk {
     std::vector<Mesh> levels;

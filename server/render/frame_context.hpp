@@ -27,6 +27,9 @@ struct FrameContext {
   // The state after this frame's step; waits for the step. Only passes that declare
   // PassDecl::reads_step call it (through water() and rain()).
   std::function<const sim::SceneState&()> stepped;
+  // Chunked geometry takes its level of detail as from this many times as far (the road
+  // reflection, at a quarter of the view's size, needs a quarter of the detail).
+  float detail_distance_scale = 1.0f;
 
   const sim::WindshieldState& water() const { return stepped().windshield; }
   const sim::RainState& rain() const { return stepped().rain; }
@@ -49,7 +52,9 @@ struct FrameResources {
   TargetTexture scene_blur;
   GLuint glass_layer_fbo = 0;
   TargetTexture glass_layer;
-  TargetTexture glass_water;  // the session's glass water map
+  TargetTexture glass_water;      // the session's glass water map
+  TargetTexture road_reflection;  // drawn before the passes where the view reads it
+  TargetTexture road_reflection_depth;
 };
 
 // Resources made once and shared by the passes.

@@ -17,13 +17,20 @@ std::string_view resource_name(Resource r) {
       return "glass layer";
     case Resource::kGlassWater:
       return "glass water map";
+    case Resource::kRoadWater:
+      return "road water";
+    case Resource::kRoadReflection:
+      return "road reflection";
   }
   return "?";
 }
 
 void check_pass_order(std::string_view view, const std::vector<Pass*>& passes) {
-  std::vector<Resource> available = {Resource::kViewColour, Resource::kViewDepth,
-                                     Resource::kGlassWater};
+  // The frame provides these from its start (the simulation's, or drawn before the passes).
+  const std::vector<Resource> provided = {Resource::kGlassWater, Resource::kRoadWater,
+                                          Resource::kRoadReflection};
+  std::vector<Resource> available = {Resource::kViewColour, Resource::kViewDepth};
+  available.insert(available.end(), provided.begin(), provided.end());
   auto fail = [&](const PassDecl& d, std::string_view what, Resource r) {
     throw std::logic_error(std::string(view) + " view, pass " + d.name + ": " + std::string(what) +
                            " " + std::string(resource_name(r)));
@@ -42,7 +49,8 @@ void check_pass_order(std::string_view view, const std::vector<Pass*>& passes) {
                              ": must write one target");
     }
     for (Resource r : d.writes) {
-      if (r == Resource::kGlassWater) fail(d, "cannot write", r);
+      if (std::find(provided.begin(), provided.end(), r) != provided.end())
+        fail(d, "cannot write", r);
       available.push_back(r);
     }
   }

@@ -21,8 +21,12 @@ enum class Resource : std::uint8_t {
   kSceneBlur,   // the scene outside the glass, an eighth of the view
   kGlassLayer,  // the water on the glass over the scene, reduced size, premultiplied
   kGlassWater,  // the session's glass water map, uploaded from the simulation on first read
+  kRoadWater,   // the road's water around the car, uploaded from the simulation on first read
+  // The scene mirrored in the road's plane with its depth, a quarter of the view: the renderer
+  // draws it before the view's passes where one reads it and the road is wet.
+  kRoadReflection,
 };
-inline constexpr std::size_t kResourceCount = 5;
+inline constexpr std::size_t kResourceCount = 7;
 std::string_view resource_name(Resource resource);
 
 struct PassDecl {

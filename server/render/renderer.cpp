@@ -33,7 +33,8 @@ namespace downpour::render {
 namespace {
 
 constexpr int kReadbackSlots = 2;
-constexpr int kSceneBlurScale = 8;  // the refraction background's size, 1 / 8 of the view
+constexpr int kSceneBlurScale = 8;   // the refraction background's size, 1 / 8 of the view
+constexpr int kReflectionScale = 4;  // the road reflection's, 1 / 4
 constexpr std::size_t kMaxTransients = 12;
 constexpr std::chrono::seconds kFenceDeadline{10};
 
@@ -98,11 +99,41 @@ struct ViewTarget {
 // A target that lives only within a frame (the scene blur, the glass layer), kept by size.
 struct Transient {
   Texture texture;
+  Texture depth;  // the road reflection's
   Framebuffer fbo;
   int width = 0;
   int height = 0;
   std::uint64_t last_frame = 0;  // the last frame that drew into it
 };
+
+// The plane the road reflection mirrors the scene in: the road's surface under the car (its grade
+// and height; the crown is left to the shader's own normal), as a plane and a reflection matrix.
+struct Mirror {
+  glm::vec4 plane{0.0f, 0.0f, 1.0f, 0.0f};  // n.p + w = 0
+  glm::mat4 matrix{1.0f};
+};
+
+Mirror mirror_under(const sim::Track& track, const sim::VehicleState& vehicle) {
+  const glm::dvec2 xy(vehicle.position_m);
+  const sim::Track::Projection p = track.project(xy, 50.0);
+  const sim::TrackFrame f = track.at(p.s);
+  const glm::dvec3 along =
+      glm::normalize(glm::dvec3(std::cos(f.heading_rad), std::sin(f.heading_rad), f.grade));
+  glm::dvec3 n = glm::normalize(glm::cross(along, glm::dvec3(f.left, 0.0)));
+  if (n.z < 0.0) n = -n;
+  const glm::dvec3 point(xy, track.surface_height(p.s, p.lateral));
+  Mirror m;
+  const double w = -glm::dot(n, point);
+  m.plane = glm::vec4(glm::vec3(n), static_cast<float>(w));
+  // x' = x - 2 (n.x + w) n
+  glm::dmat4 r(1.0);
+  for (int c = 0; c < 3; ++c) {
+    for (int row = 0; row < 3; ++row) r[c][row] -= 2.0 * n[row] * n[c];
+  }
+  for (int row = 0; row < 3; ++row) r[3][row] = -2.0 * w * n[row];
+  m.matrix = glm::mat4(r);
+  return m;
+}
 
 GLuint unit_of(Resource r) {
   switch (r) {
@@ -116,6 +147,10 @@ GLuint unit_of(Resource r) {
       return texture_unit::kGlassLayer;
     case Resource::kGlassWater:
       return texture_unit::kGlassWater;
+    case Resource::kRoadWater:
+      return texture_unit::kRoadWater;
+    case Resource::kRoadReflection:
+      return texture_unit::kReflection;
   }
   return 0;
 }
@@ -131,6 +166,11 @@ struct RenderSession::Impl {
   int water_width = 0;
   int water_height = 0;
   std::uint64_t water_stamp = 0;
+  // The road's water window on the GPU and the image it shows (held, so that its address names it).
+  Texture road_water;
+  int road_cells = 0;
+  std::shared_ptr<const sim::RoadWaterImage> road_shown;
+  bool road_dry_shown = false;
 };
 
 RenderSession::RenderSession(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -149,6 +189,9 @@ struct Renderer::Impl {
   std::unique_ptr<RenderSession> image_session;  // render_image's
   RainPass* rain = nullptr;                      // one of passes
   std::uint32_t rain_streaks = 0;                // drawn by the last render()
+  // What the road reflection draws, mirrored (passes of the views), and the views that read it.
+  std::vector<Pass*> reflected;
+  std::array<bool, sim::kViewCount> reads_reflection{};
 
   template <typename Fn>
   void timed(const std::string& name, Fn&& fn) {
@@ -166,7 +209,32 @@ struct Renderer::Impl {
     return static_cast<P*>(passes.back().get());
   }
 
-  void upload_frame_block(const FrameContext& f) {
+  // The frame's water and mirror: the window's place, the reflection's matrix and plane.
+  struct WaterBlock {
+    Mirror mirror;
+    glm::vec4 clip_plane{0.0f, 0.0f, 0.0f, 1.0f};
+    glm::vec4 road_water{0.0f};
+    glm::vec4 road_water_state{0.5f, 0.0f, 0.0f, 0.0f};
+  };
+
+  static WaterBlock water_block(const FrameContext& f, const Mirror& mirror, bool reflection) {
+    WaterBlock w;
+    w.mirror = mirror;
+    w.road_water.w = reflection ? 1.0f : 0.0f;
+    if (const sim::RoadWaterImage* image = f.scene.road_water.get();
+        image && image->cells > 0 &&
+        image->water_standing_mm.size() >=
+            static_cast<std::size_t>(image->cells) * image->cells * 2) {
+      w.road_water.x = static_cast<float>(image->origin.x * image->cell_m);
+      w.road_water.y = static_cast<float>(image->origin.y * image->cell_m);
+      w.road_water.z = static_cast<float>(1.0 / (image->cells * image->cell_m));
+      w.road_water_state = glm::vec4(static_cast<float>(image->capacity_mm), image->mean_water_mm,
+                                     image->mean_standing_mm, 1.0f);
+    }
+    return w;
+  }
+
+  void upload_frame_block(const FrameContext& f, const WaterBlock& water) {
     FrameBlock b;
     b.view_proj = f.camera.projection * f.camera.view;
     b.inv_view_proj = glm::inverse(b.view_proj);
@@ -182,6 +250,12 @@ struct Renderer::Impl {
     const float wind_dir = glm::radians(static_cast<float>(f.scene.weather.wind_direction_deg));
     b.wind = glm::vec4(std::cos(wind_dir), std::sin(wind_dir), 0.0f, 0.0f) *
              static_cast<float>(f.scene.weather.wind_speed_mps);
+    // (In the reflection's own frame, view_proj is already mirrored: the road reads these only in
+    // the view's.)
+    b.mirror_view_proj = b.view_proj * water.mirror.matrix;
+    b.clip_plane = water.clip_plane;
+    b.road_water = water.road_water;
+    b.road_water_state = water.road_water_state;
     glNamedBufferSubData(frame_ubo.id(), 0, sizeof(b), &b);
   }
 
@@ -200,12 +274,21 @@ struct Renderer::Impl {
       t.texture = make_texture_2d(GL_RGBA8, width, height);
       glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_S, GL_MIRRORED_REPEAT);
       glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_T, GL_MIRRORED_REPEAT);
+    } else if (r == Resource::kRoadReflection) {
+      t.texture = make_texture_2d(GL_RGBA8, width, height);
+      t.depth = make_texture_2d(GL_DEPTH_COMPONENT32F, width, height);
+      for (GLuint id : {t.texture.id(), t.depth.id()}) {
+        glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      }
+      glTextureParameteri(t.depth.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTextureParameteri(t.depth.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     } else {
       t.texture = make_texture_2d(GL_RGBA8, width, height);
       glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
       glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     }
-    t.fbo = framebuffer_with(t.texture.id(), 0);
+    t.fbo = framebuffer_with(t.texture.id(), t.depth.id());
     return transients.emplace(key, std::move(t)).first->second;
   }
 
@@ -253,6 +336,80 @@ struct Renderer::Impl {
     s.water_stamp = map.stamp;
   }
 
+  // The session's road water window brought up to the frame's: a whole upload for each new image
+  // (one per road step: 128 x 128 cells, two half floats each).
+  void upload_road_water(RenderSession::Impl& s,
+                         const std::shared_ptr<const sim::RoadWaterImage>& image) {
+    const bool valid = image && image->cells > 0 &&
+                       image->water_standing_mm.size() >=
+                           static_cast<std::size_t>(image->cells) * image->cells * 2;
+    const int n = valid ? image->cells : 1;
+    if (!s.road_water.id() || s.road_cells != n) {
+      s.road_water = make_texture_2d(GL_RG16F, n, n);
+      glTextureParameteri(s.road_water.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTextureParameteri(s.road_water.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      s.road_cells = n;
+      s.road_shown.reset();
+      s.road_dry_shown = false;
+    }
+    if (!valid) {
+      if (!s.road_dry_shown) {
+        const float dry[2] = {0.0f, 0.0f};
+        glTextureSubImage2D(s.road_water.id(), 0, 0, 0, 1, 1, GL_RG, GL_FLOAT, dry);
+        s.road_dry_shown = true;
+        s.road_shown.reset();
+      }
+      return;
+    }
+    if (s.road_shown == image) return;
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTextureSubImage2D(s.road_water.id(), 0, 0, 0, n, n, GL_RG, GL_FLOAT,
+                        image->water_standing_mm.data());
+    s.road_shown = image;
+    s.road_dry_shown = false;
+  }
+
+  // Whether the road's water shows a mirror anywhere: a film standing on it (road.frag's film),
+  // or, without the simulation's water, heavy enough rain for the weather's film.
+  static bool road_reflects(const FrameContext& f) {
+    if (const sim::RoadWaterImage* image = f.scene.road_water.get())
+      return image->max_standing_mm > 0.03f;
+    return f.atmosphere.wetness > 0.3f;
+  }
+
+  // The scene mirrored in the road's plane, from the view's camera, at a quarter of its size:
+  // the passes of `reflected` with a mirrored frame block, clipped to above the plane.
+  void draw_reflection(const FrameContext& f, const Mirror& mirror, FrameResources& r) {
+    const int w = std::max(1, (r.view_colour.width + kReflectionScale - 1) / kReflectionScale);
+    const int h = std::max(1, (r.view_colour.height + kReflectionScale - 1) / kReflectionScale);
+    Transient& t = transient(Resource::kRoadReflection, w, h);
+    Camera mirrored = f.camera;
+    mirrored.view = f.camera.view * mirror.matrix;
+    mirrored.position = glm::vec3(mirror.matrix * glm::vec4(f.camera.position, 1.0f));
+    FrameContext mf{f.scene, f.spec,   mirrored, f.atmosphere, f.vehicle_to_world,
+                    f.glass, f.stepped};
+    mf.detail_distance_scale = kReflectionScale;
+    WaterBlock clip;
+    clip.clip_plane = mirror.plane;
+    clip.clip_plane.w += 0.02f;  // what touches the road stays whole
+    upload_frame_block(mf, clip);
+    glBindFramebuffer(GL_FRAMEBUFFER, t.fbo.id());
+    glViewport(0, 0, w, h);
+    apply(RenderState{DepthTest::kOff, true, Blend::kOff});
+    const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+    const float zero_depth = 0.0f;
+    glClearNamedFramebufferfv(t.fbo.id(), GL_COLOR, 0, black);
+    glClearNamedFramebufferfv(t.fbo.id(), GL_DEPTH, 0, &zero_depth);
+    glEnable(GL_CLIP_DISTANCE0);
+    for (Pass* pass : reflected) {
+      apply(pass->decl().state);
+      pass->execute(mf, r);
+    }
+    glDisable(GL_CLIP_DISTANCE0);
+    r.road_reflection = {t.texture.id(), w, h};
+    r.road_reflection_depth = {t.depth.id(), w, h};
+  }
+
   void run_pass(Pass& pass, const FrameContext& f, RenderSession::Impl& session,
                 FrameResources& r) {
     if (!pass.wanted(f)) return;
@@ -282,6 +439,14 @@ struct Renderer::Impl {
           upload_glass_water(session, f.water().map);
           r.glass_water = {session.glass_water.id(), session.water_width, session.water_height};
           texture = r.glass_water.texture;
+          break;
+        case Resource::kRoadWater:
+          upload_road_water(session, f.scene.road_water);
+          texture = session.road_water.id();
+          break;
+        case Resource::kRoadReflection:
+          texture = r.road_reflection.texture;
+          glBindTextureUnit(texture_unit::kReflectionDepth, r.road_reflection_depth.texture);
           break;
       }
       glBindTextureUnit(unit_of(res), texture);
@@ -361,6 +526,7 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   Pass* glass_water = impl->add<GlassWaterPass>();
   Pass* glass_composite = impl->add<GlassCompositePass>();
   Pass* windshield = impl->add<WindshieldPass>();
+  impl->reflected = {vehicles, terrain, sky};
   auto& views = impl->views;
   views[static_cast<int>(sim::View::kCockpit)] = {
       cockpit, vehicles, road, terrain, sky, rain, glass_background, glass_water, glass_composite};
@@ -368,8 +534,16 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   views[static_cast<int>(sim::View::kWindshield)] = {windshield};
   // The rain layer alone from the driver's eye: the scene for its depth, then black, then rain.
   views[static_cast<int>(sim::View::kRain)] = {cockpit, vehicles, road, terrain, rain_mask, rain};
-  for (int v = 0; v < sim::kViewCount; ++v)
+  for (int v = 0; v < sim::kViewCount; ++v) {
     check_pass_order(sim::view_name(static_cast<sim::View>(v)), views[v]);
+    for (const Pass* pass : views[v]) {
+      const auto& reads = pass->decl().reads;
+      if (std::find(reads.begin(), reads.end(), Resource::kRoadReflection) != reads.end())
+        impl->reads_reflection[v] = true;
+    }
+  }
+  // RAIN draws the scene for its depth alone: its road needs no mirror.
+  impl->reads_reflection[static_cast<int>(sim::View::kRain)] = false;
   if (glGetError() != GL_NO_ERROR) throw std::runtime_error("GL error while creating the renderer");
   return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
 }
@@ -428,10 +602,16 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
   const float zero_depth = 0.0f;
   glClearNamedFramebufferfv(target->fbo.id(), GL_COLOR, 0, black);
   glClearNamedFramebufferfv(target->fbo.id(), GL_DEPTH, 0, &zero_depth);
-  m.upload_frame_block(frame);
   ++m.frame;
   m.evict_transients();
   m.written.fill(false);
+  const Mirror mirror = mirror_under(m.shared->track, scene.vehicle);
+  const bool reflection =
+      m.reads_reflection[static_cast<int>(spec.view)] && Impl::road_reflects(frame);
+  if (reflection) m.timed("road_reflection", [&] { m.draw_reflection(frame, mirror, resources); });
+  m.upload_frame_block(frame, Impl::water_block(frame, mirror, reflection));
+  glBindFramebuffer(GL_FRAMEBUFFER, target->fbo.id());
+  glViewport(0, 0, spec.width, spec.height);
   m.rain->take_drawn();
   for (Pass* pass : m.views[static_cast<int>(spec.view)]) {
     m.timed(pass->decl().name, [&] { m.run_pass(*pass, frame, s, resources); });

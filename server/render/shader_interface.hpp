@@ -22,22 +22,35 @@ namespace downpour::render {
   X(kGlassLayer, 7, sampler2D, glass_layer_tex,                                                  \
     "the water on the glass over the scene, reduced size, premultiplied")                        \
   X(kRainLayer, 8, sampler2D, rain_layer_tex,                                                    \
-    "the rain streaks, reduced size, premultiplied (rain_layer.hpp)")
+    "the rain streaks, reduced size, premultiplied (rain_layer.hpp)")                            \
+  X(kRoadWater, 9, sampler2D, road_water_tex,                                                    \
+    "the road's water around the car: r water, g standing water (mm), per 0.25 m cell")          \
+  X(kReflection, 10, sampler2D, reflection_tex,                                                  \
+    "the scene mirrored in the road's plane, reduced size, mipmapped (display-encoded)")         \
+  X(kReflectionDepth, 11, sampler2D, reflection_depth_tex, "its depth (reversed-Z)")
 
 // The per-frame uniform block: X(GLSL type, name, comment). Every field is a vec4 or a mat4, so
 // the C++ struct below has the std140 layout as it is.
-#define DOWNPOUR_FRAME_BLOCK(X)                                                \
-  X(mat4, view_proj, "world to clip")                                          \
-  X(mat4, inv_view_proj, "clip to world")                                      \
-  X(vec4, camera_pos, "xyz world position of the camera")                      \
-  X(vec4, sun_dir, "xyz unit direction towards the sun")                       \
-  X(vec4, sun_radiance, "rgb direct sunlight reaching the ground")             \
-  X(vec4, sky_zenith, "rgb")                                                   \
-  X(vec4, sky_horizon, "rgb")                                                  \
-  X(vec4, ambient, "rgb light from the whole sky on an upward surface")        \
-  X(vec4, fog, "rgb colour, a extinction per metre")                           \
-  X(vec4, params, "x sim time (s), y overcast, z wetness, w rain rate (mm/h)") \
-  X(vec4, wind, "xy wind velocity (m/s, world)")
+#define DOWNPOUR_FRAME_BLOCK(X)                                                               \
+  X(mat4, view_proj, "world to clip")                                                         \
+  X(mat4, inv_view_proj, "clip to world")                                                     \
+  X(vec4, camera_pos, "xyz world position of the camera")                                     \
+  X(vec4, sun_dir, "xyz unit direction towards the sun")                                      \
+  X(vec4, sun_radiance, "rgb direct sunlight reaching the ground")                            \
+  X(vec4, sky_zenith, "rgb")                                                                  \
+  X(vec4, sky_horizon, "rgb")                                                                 \
+  X(vec4, ambient, "rgb light from the whole sky on an upward surface")                       \
+  X(vec4, fog, "rgb colour, a extinction per metre")                                          \
+  X(vec4, params, "x sim time (s), y overcast, z wetness, w rain rate (mm/h)")                \
+  X(vec4, wind, "xy wind velocity (m/s, world)")                                              \
+  X(mat4, mirror_view_proj, "world to the reflection's clip: view_proj times the mirror")     \
+  X(vec4, clip_plane, "what is drawn: n.p + w >= 0 (the road reflection's, else everything)") \
+  X(vec4, road_water,                                                                         \
+    "xy the water window's lower-left corner (world m), z 1 / its side (m), "                 \
+    "w 1 with a reflection drawn, else 0")                                                    \
+  X(vec4, road_water_state,                                                                   \
+    "x capacity (mm), y z the window's mean water and standing water "                        \
+    "(mm), w 1 with the window, else 0 (the wetness alone)")
 
 inline constexpr unsigned kFrameBlockBinding = 0;
 

@@ -2,7 +2,10 @@
 // test suite, and a way to draw a view of a scene into an RGBA image.
 #pragma once
 
+#include <cstdlib>
+#include <filesystem>
 #include <memory>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -25,6 +28,25 @@ class RenderTest : public ::testing::Test {
     return {spec.width, spec.height, render::render_image(*renderer_, spec, scene)};
   }
   static render::Renderer& renderer() { return *renderer_; }
+
+  // The image against tests/golden/<name>, within 32 dB of PSNR; with DOWNPOUR_UPDATE_GOLDEN set,
+  // rewrites the golden file instead (then look at it).
+  static void expect_golden(const RgbaImage& image, const std::string& name) {
+    const std::string golden = std::string(DOWNPOUR_GOLDEN_DIR) + "/" + name;
+    if (std::getenv("DOWNPOUR_UPDATE_GOLDEN")) {
+      write_png(golden, image);
+      GTEST_SKIP() << "wrote " << golden;
+    }
+    ASSERT_TRUE(std::filesystem::exists(golden))
+        << golden << " is missing; run with DOWNPOUR_UPDATE_GOLDEN=1";
+    const double db = psnr(image, read_png(golden));
+    if (db < 32.0) {
+      const std::string actual = ::testing::TempDir() + "actual_" + name;
+      write_png(actual, image);
+      ADD_FAILURE() << name << ": PSNR " << db
+                    << " dB against the golden image; this render: " << actual;
+    }
+  }
 
   // The highway scene with dry glass, its water not simulated: for tests that bring their own.
   // No streaks in the air either: these tests measure the glass against a still background.

@@ -1,8 +1,6 @@
 // Render tests on llvmpipe: each view against a golden PNG, and properties a golden file cannot
 // fake. Set DOWNPOUR_UPDATE_GOLDEN=1 to rewrite the golden files after a deliberate change (then
 // look at them).
-#include <cstdlib>
-#include <filesystem>
 #include <memory>
 
 #include <gtest/gtest.h>
@@ -48,22 +46,7 @@ TEST_P(GoldenTest, MatchesGoldenImage) {
   // A hand-made windshield, so that the pictures do not move with the water simulation.
   sim::SceneState scene = highway_scene();
   scene.windshield = testing::golden_windshield(scene.glass);
-  const RgbaImage image = render(view, scene);
-  const std::string name = std::string(sim::view_name(view)) + ".png";
-  const std::string golden = std::string(DOWNPOUR_GOLDEN_DIR) + "/" + name;
-  if (std::getenv("DOWNPOUR_UPDATE_GOLDEN")) {
-    testing::write_png(golden, image);
-    GTEST_SKIP() << "wrote " << golden;
-  }
-  ASSERT_TRUE(std::filesystem::exists(golden))
-      << golden << " is missing; run with DOWNPOUR_UPDATE_GOLDEN=1";
-  const double db = testing::psnr(image, testing::read_png(golden));
-  if (db < 32.0) {
-    const std::string actual = ::testing::TempDir() + "actual_" + name;
-    testing::write_png(actual, image);
-    ADD_FAILURE() << name << ": PSNR " << db
-                  << " dB against the golden image; this render: " << actual;
-  }
+  expect_golden(render(view, scene), std::string(sim::view_name(view)) + ".png");
 }
 
 INSTANTIATE_TEST_SUITE_P(Views, GoldenTest,

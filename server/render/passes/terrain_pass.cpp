@@ -12,7 +12,8 @@ TerrainPass::TerrainPass(SharedResources& shared)
 
 void TerrainPass::execute(const FrameContext& frame, const FrameResources&) {
   program_.use();
-  chunks_.draw_visible(frame.camera.projection * frame.camera.view, frame.camera.position);
+  chunks_.draw_visible(frame.camera.projection * frame.camera.view, frame.camera.position,
+                       frame.detail_distance_scale);
 }
 
 }  // namespace downpour::render

@@ -1,0 +1,194 @@
+// The road surface, included by its three programs (road_pass.cpp picks one per frame, since
+// llvmpipe pays for both sides of a branch on every pixel): road.frag without a mirror (a dry or
+// only wet road), road_mirror.frag with the road reflection (a film stands somewhere), and
+// road_ripples.frag with the reflection and the rings of drops in puddles (puddles in the rain).
+#include "common.glsl"
+in vec3 v_world;
+in vec3 v_normal;
+in vec2 v_uv;  // x lateral offset (m, left positive), y distance along the track (m)
+in vec4 v_fog;
+out vec4 out_colour;
+
+uniform float u_lane_width;
+uniform int u_lanes_each_way;
+uniform float u_paved_half_width;
+
+const float kReliefTile = 1.5;  // metres of road per repeat of the relief texture
+
+// Coverage of a painted stripe of half width hw centred at c, antialiased over one pixel.
+float stripe(float x, float c, float hw) {
+  float w = max(fwidth(x), 1e-4);
+  return clamp((hw - abs(x - c)) / w + 0.5, 0.0, 1.0);
+}
+
+// The water at xy: x all of it (mm), y the part standing above the texture (mm). From the road's
+// water window where it reaches, fading over its last 2 m to the window's mean; without a window,
+// the weather's wetness alone.
+vec2 water_at(vec2 xy) {
+  float wet = frame.params.z;
+  if (frame.road_water_state.w == 0.0) return vec2(wet * 0.5, wet * wet * 0.15);
+  vec2 uv = (xy - frame.road_water.xy) * frame.road_water.z;
+  vec2 edge_m = min(uv, 1.0 - uv) / frame.road_water.z;
+  float inside = clamp(min(edge_m.x, edge_m.y) * 0.5, 0.0, 1.0);
+  return mix(frame.road_water_state.yz, texture(road_water_tex, uv).rg, inside);
+}
+
+#ifdef ROAD_RIPPLES
+uint hash_u(uint x) {
+  x ^= x >> 16; x *= 0x7feb352du; x ^= x >> 15; x *= 0x846ca68bu; x ^= x >> 16;
+  return x;
+}
+vec3 hash3(ivec2 cell, int cycle) {
+  uint h = hash_u(uint(cell.x) * 0x9e3779b9u ^ hash_u(uint(cell.y) + uint(cycle) * 0x85ebca6bu));
+  uvec3 b = uvec3(h, h >> 11, h >> 22) & uvec3(2047u, 2047u, 1023u);
+  return vec3(b) / vec3(2047.0, 2047.0, 1023.0);
+}
+
+// Ripples (seed 004): every drop that lands in a puddle starts a ring that grows toward the
+// puddle's size while it sinks and fades. Each 0.35 m cell of the world's grid holds one drop per
+// life of a ring, landing at a random point, with a probability that follows the rain rate (up to
+// about 8 rings per m^2 and second in a cloudburst). A pixel sums the rings of its 2 x 2 nearest
+// cells; returns the slope they give the water (world xy).
+const float kRippleCell = 0.35;
+const float kRippleLife = 0.9;  // s
+vec3 ripple_slope(vec2 xy, float standing_mm) {
+  float chance = clamp(frame.params.w / 25.0, 0.0, 1.0);
+  if (chance <= 0.0) return vec3(0.0);
+  // Rings reach a cell's half in a deep puddle, less in a shallow one.
+  float reach = kRippleCell * 0.5 * clamp(standing_mm / 4.0, 0.35, 1.0);
+  vec2 g = xy / kRippleCell;
+  ivec2 base = ivec2(floor(g - 0.5));
+  vec2 slope = vec2(0.0);
+  for (int k = 0; k < 4; ++k) {
+    ivec2 cell = base + ivec2(k & 1, k >> 1);
+    vec3 h0 = hash3(cell, 0);
+    float phase = frame.params.x / kRippleLife + h0.z;
+    int cycle = int(floor(phase));
+    float age = phase - float(cycle);
+    vec3 h = hash3(cell, cycle + 1);
+    vec2 centre = (vec2(cell) + 0.2 + 0.6 * h.xy) * kRippleCell;
+    vec2 d = xy - centre;
+    float dist = length(d) + 1e-4;
+    float x = (dist - age * reach) * (1.0 / 0.025);
+    // A ring of two crests, sinking and fading with age; none where the cycle's drop did not fall.
+    float fade = (1.0 - age) * (1.0 - age) * step(h.z, chance);
+    float wave = x * exp(-x * x) * fade;
+    slope += d / dist * wave;
+  }
+  return vec3(-slope * 0.8, 0.0);
+}
+#endif
+
+#ifdef ROAD_MIRROR
+// The display's encoding undone (common.glsl's to_display): the mirror is stored as displayed.
+vec3 from_display(vec3 c) {
+  vec3 x = c * c;
+  return x / max(1.0 - 0.15 * x, 0.05);
+}
+
+// What the ray r from p on the road sees in the quarter-size mirror (`sky` where it sees none): where the mirror image of the
+// pixel lies (its depth), how far along r that is, and where that point's mirror image falls.
+// On the mirror's plane with its normal this is the pixel itself; a surface on a crest or in a
+// dip, tilted by the crown or moved by ripples, looks up its own reflection. The sky beyond the
+// mirror's edges.
+vec3 mirrored(vec3 p, vec3 r, vec3 sky, float streak) {
+  vec4 clip = frame.view_proj * vec4(p, 1.0);
+  vec2 uv0 = clip.xy / clip.w * 0.5 + 0.5;
+  float d = textureLod(reflection_depth_tex, uv0, 0.0).r;
+  // Reversed-Z with an infinite far plane: depth = near / distance along the view axis, and
+  // clip.z is the near distance for every point.
+  float a = d * clip.w;
+  float b = length(p - frame.camera_pos.xyz) * max(clip.z - a, 0.0);
+  vec4 c = frame.mirror_view_proj * vec4(p * a + r * b, a);
+  if (c.w <= 1e-5) return sky;
+  vec2 uv = c.xy / c.w * 0.5 + 0.5;
+  vec2 inside = clamp(min(uv, 1.0 - uv) * 20.0, 0.0, 1.0);
+  // A streak on a film: two taps along the image's vertical, 3 texels of the mirror apart.
+  vec2 dv = vec2(0.0, 1.5 * streak / float(textureSize(reflection_tex, 0).y));
+  vec3 seen = from_display((textureLod(reflection_tex, uv - dv, 0.0).rgb +
+                            textureLod(reflection_tex, uv + dv, 0.0).rgb) * 0.5);
+  return mix(sky, seen, inside.x * inside.y);
+}
+#endif
+
+void main() {
+  float lat = v_uv.x;
+  float s = v_uv.y;
+  float a = abs(lat);
+  float lanes = u_lane_width * float(u_lanes_each_way);
+
+  // Surface frame: normal from the mesh, tangent along the track from the uv derivatives.
+  vec3 n_geo = normalize(v_normal);
+  vec3 dp_dx = dFdx(v_world), dp_dy = dFdy(v_world);
+  vec2 duv_dx = dFdx(v_uv), duv_dy = dFdy(v_uv);
+  vec3 t_along = dp_dx * duv_dy.x - dp_dy * duv_dx.x;  // direction of growing s
+  t_along = normalize(t_along - n_geo * dot(n_geo, t_along) + 1e-6);
+  vec3 t_lat = cross(n_geo, t_along);
+
+  vec4 relief = texture(asphalt_tex, vec2(lat, s) / kReliefTile);
+  // Fade the relief with distance, where its texels get smaller than a pixel.
+  float detail = clamp(1.5 - length(fwidth(v_uv)) * 6.0, 0.0, 1.0);
+  vec3 rn = relief.rgb * 2.0 - 1.0;
+  vec3 n = normalize(mix(n_geo, normalize(t_lat * rn.x + t_along * rn.y + n_geo * rn.z), detail));
+
+  // Asphalt: light aggregate in dark binder; worn, darker wheel paths; patches.
+  float h = relief.a;
+  float patches = texture(noise_tex, vec2(lat, s) / 40.0).g;
+  vec3 albedo = vec3(mix(0.055, 0.16, smoothstep(0.15, 0.8, h))) * (0.85 + 0.3 * patches);
+  float lane_pos = fract(a / u_lane_width);
+  float wheel_paths = stripe(lane_pos, 0.27, 0.09) + stripe(lane_pos, 0.73, 0.09);
+  albedo *= 1.0 - 0.18 * clamp(wheel_paths, 0.0, 1.0) * step(a, lanes);
+
+  // Markings: double centre line, dashed lane dividers (3 m on, 9 m off), solid edge lines.
+  float paint = stripe(a, 0.2, 0.07);
+  for (int i = 1; i < u_lanes_each_way; ++i) {
+    paint += stripe(a, u_lane_width * float(i), 0.075) * step(fract(s / 12.0), 0.25);
+  }
+  paint += stripe(a, lanes + 0.2, 0.1);
+  paint = clamp(paint, 0.0, 1.0);
+  albedo = mix(albedo, vec3(0.72, 0.72, 0.68), paint);
+  n = normalize(mix(n, n_geo, paint * 0.8));  // paint fills the relief
+
+  // Beyond the pavement: gravel verge, then grass.
+  float verge = smoothstep(u_paved_half_width, u_paved_half_width + 0.05, a);
+  vec3 gravel = vec3(0.16, 0.15, 0.13) * (0.7 + 0.6 * h);
+  vec3 grass = vec3(0.11, 0.16, 0.06) * (0.8 + 0.4 * patches);
+  albedo = mix(albedo, mix(gravel, grass, smoothstep(u_paved_half_width + 1.0, u_paved_half_width + 2.5, a)), verge);
+
+  // The water here (seed 003): the pores of the texture fill (wet: darker, the diffuse reduction
+  // hd), a film stands over them (drench: smoother, a blurred mirror), then a puddle (a mirror
+  // that ripples under the drops, over the ground seen through it).
+  vec2 water = water_at(v_world.xy);
+  float weather_wet = frame.params.z;
+  // Off the pavement the verge drinks the rain: wet by the weather alone, never standing water.
+  float fill = mix(clamp(water.x / frame.road_water_state.x, 0.0, 1.0), weather_wet, verge);
+  float film = smoothstep(0.0, 0.3, water.y) * (1.0 - verge);
+  float pool = smoothstep(0.6, 2.0, water.y) * (1.0 - verge);
+  albedo *= mix(1.0, 0.5, fill) * mix(1.0, 0.7, film);
+  vec3 view = normalize(frame.camera_pos.xyz - v_world);
+  vec3 colour = albedo * diffuse_light(n);
+
+  vec3 n_refl = normalize(mix(mix(n, n_geo, 0.8 * film), n_geo, pool));
+#ifdef ROAD_RIPPLES
+  n_refl = normalize(n_refl + ripple_slope(v_world.xy, water.y) * pool);
+#endif
+  float cos_v = dot(n_refl, view);
+  vec3 r = reflect(-view, n_refl);
+  float fresnel = schlick(cos_v, 0.02);
+  // Gravel and grass off the pavement never mirror: a wet sheen at most. On the pavement the
+  // mirror strengthens and sharpens as the water rises over the texture: streaked along the view
+  // on a film (the texture's peaks still break it), clear on a puddle.
+  float smooth_water = film;
+  float k = fresnel * mix(0.2 + 0.3 * fill * (1.0 - verge), 1.0, max(smooth_water, pool));
+  vec3 refl = sky_gradient(r);
+#ifdef ROAD_MIRROR
+  refl = mix(refl, mirrored(v_world, r, refl, 1.0 - pool), step(1e-3, smooth_water));
+#endif
+  // A sheen of the sun on the film, broader than the sun in the mirror.
+  float sun = max(dot(r, frame.sun_dir.xyz), 0.0);
+  float s2 = sun * sun, s4 = s2 * s2, s8 = s4 * s4;
+  refl += frame.sun_radiance.rgb * (s8 * s8) * 0.6 * film * (1.0 - frame.params.y * 0.7);
+  // The mirror has its own haze (drawn from the mirrored eye along the whole path): only the ground
+  // takes the haze of its own distance.
+  out_colour = vec4(to_display(apply_fog(colour * (1.0 - k), v_fog) + refl * k), 1.0);
+}

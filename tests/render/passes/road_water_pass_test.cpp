@@ -1,0 +1,129 @@
+// The water on the road, measured on the image: a wet road is darker than a dry one, mirrors the
+// car's tail lights, and its puddles ripple while it rains; the golden pictures of a dry road, a
+// drenched one and one with puddles.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "server/sim/scenario.hpp"
+#include "server/sim/simulation.hpp"
+#include "tests/render/render_fixture.hpp"
+#include "tests/render/road_water_fixture.hpp"
+
+namespace downpour::render {
+namespace {
+
+using testing::RgbaImage;
+
+constexpr int kWidth = 320;
+constexpr int kHeight = 180;
+
+class RoadWaterPassTest : public testing::RenderTest {
+ protected:
+  // The highway at 10 s with this rain and cloud, the glass dry and no streaks in the air (they
+  // would cover the road), and the road hand-made: a film of film_mm (0: dry), with the tests'
+  // puddles or not.
+  static sim::SceneState scene(double rain_mm_h, double film_mm, bool puddles,
+                               double cloudiness = 0.95) {
+    sim::SceneState s = testing::highway_scene(rain_mm_h, cloudiness, false);
+    s.rain.drops.clear();
+    s.rain.splashes.clear();
+    s.weather.wind_speed_mps = 0.0;  // still clouds: only ripples move on the road
+    s.road_water = testing::hand_road_water(
+        s.vehicle, film_mm, puddles ? testing::test_puddles() : std::vector<testing::HandPuddle>{});
+    return s;
+  }
+  static RgbaImage render(sim::View view, const sim::SceneState& s) {
+    return RenderTest::render(view_spec(view, kWidth, kHeight), s);
+  }
+  // Pixels in [x0, x1) x [y0, y1) whose red stands out of the grey road (by 5 levels of 255): a
+  // lit lamp or its mirror image.
+  static int red_pixels(const RgbaImage& image, int x0, int y0, int x1, int y1) {
+    int n = 0;
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        const std::uint8_t* p = &image.pixels[(static_cast<std::size_t>(y) * image.width + x) * 4];
+        n += p[0] > std::max(p[1], p[2]) + 4;
+      }
+    }
+    return n;
+  }
+  static double mean_abs_difference(const RgbaImage& a, const RgbaImage& b, int x0, int y0, int x1,
+                                    int y1) {
+    double sum = 0.0;
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        const std::size_t i = (static_cast<std::size_t>(y) * a.width + x) * 4;
+        for (int c = 0; c < 3; ++c) sum += std::abs(a.pixels[i + c] - b.pixels[i + c]);
+      }
+    }
+    return sum / ((y1 - y0) * (x1 - x0) * 3.0);
+  }
+};
+
+TEST_F(RoadWaterPassTest, RoadDarkensFromDryToWet) {
+  // The road behind the car in the chase view, in the car's lane, seen steeply (about 35 degrees
+  // down): the diffuse part falls as the texture fills and a film stands on it, and the film's
+  // mirror adds little at this angle. Light rain under broken cloud: the road, not the haze.
+  const auto road = [&](double film_mm) {
+    const RgbaImage image = render(sim::View::kRoad, scene(1.0, film_mm, false, 0.3));
+    return testing::mean_luma(image, kWidth * 28 / 100, kHeight * 9 / 10, kWidth * 45 / 100,
+                              kHeight);
+  };
+  const double dry = road(0.0), wet = road(0.3);
+  EXPECT_LT(wet, dry * 0.85) << "dry " << dry << ", wet " << wet;
+}
+
+TEST_F(RoadWaterPassTest, TailLightsAreMirroredBelowTheCarOnAWetRoad) {
+  // The chase camera's car: its lamps are red on the image's middle columns; below the car, on a
+  // wet road, their mirror images. In a downpour under full cloud: a lamp outshines a bright
+  // overcast sky less than the film's Fresnel (about 0.1 at this angle) can show.
+  const auto below_the_car = [&](double film_mm) {
+    const RgbaImage image = render(sim::View::kRoad, scene(40.0, film_mm, false, 1.0));
+    return red_pixels(image, kWidth * 3 / 8, kHeight * 71 / 100, kWidth * 5 / 8, kHeight);
+  };
+  const int dry = below_the_car(0.0), wet = below_the_car(0.5);
+  EXPECT_GT(wet, dry + 30) << "dry " << dry << ", wet " << wet;
+}
+
+TEST_F(RoadWaterPassTest, PuddlesRippleWhileItRainsAndStillWhenItStops) {
+  // A tenth of a second apart: the puddle behind the car (the bottom of the chase view) changes
+  // while rain falls, and not at all once it has stopped.
+  const auto change = [&](double rain_mm_h) {
+    sim::SceneState s = scene(rain_mm_h, 0.3, true);
+    const RgbaImage before = render(sim::View::kRoad, s);
+    s.sim_time_s += 0.1;
+    const RgbaImage after = render(sim::View::kRoad, s);
+    // The puddle 3.5 m behind the rear axle.
+    return mean_abs_difference(before, after, kWidth * 35 / 100, kHeight * 4 / 5, kWidth * 65 / 100,
+                               kHeight);
+  };
+  const double raining = change(20.0);
+  std::printf("mean change of the puddle in 0.1 s: %.3f of 255 while it rains\n", raining);
+  EXPECT_GT(raining, 0.08);
+  EXPECT_EQ(change(0.0), 0.0);
+}
+
+class RoadWaterGoldenTest : public RoadWaterPassTest,
+                            public ::testing::WithParamInterface<const char*> {};
+
+TEST_P(RoadWaterGoldenTest, MatchesGoldenImage) {
+  const std::string state = GetParam();
+  // Dry: no rain yet. Wet: a film all over in moderate rain. Puddles: the same with the tests'
+  // puddles, rippling (at the scene's time, so the same rings every run).
+  const sim::SceneState s = state == "dry"   ? scene(0.0, 0.0, false, 0.6)
+                            : state == "wet" ? scene(6.0, 0.3, false, 0.8)
+                                             : scene(6.0, 0.3, true, 0.8);
+  expect_golden(render(sim::View::kRoad, s), "ROAD_road_" + state + ".png");
+  expect_golden(render(sim::View::kCockpit, s), "COCKPIT_road_" + state + ".png");
+}
+
+INSTANTIATE_TEST_SUITE_P(States, RoadWaterGoldenTest, ::testing::Values("dry", "wet", "puddles"),
+                         [](const auto& info) { return std::string(info.param); });
+
+}  // namespace
+}  // namespace downpour::render
