@@ -47,6 +47,11 @@ void fill_frame(const session::EncodedFrame& f, std::uint64_t reader_drops, v1::
   s->set_drops_on_glass(f.stats.drops_on_glass);
   s->set_glass_wet_fraction(f.stats.glass_wet_fraction);
   s->set_view_wet_fraction(f.stats.view_wet_fraction);
+  v1::RoadStateFractions* road = s->mutable_road_states();
+  road->set_dry(f.stats.road_states[0]);
+  road->set_wet(f.stats.road_states[1]);
+  road->set_drench(f.stats.road_states[2]);
+  road->set_puddle(f.stats.road_states[3]);
   s->set_rain_streaks(f.stats.rain_streaks);
   s->set_visibility_m(f.stats.visibility_m);
   s->set_frames_dropped(reader_drops);

@@ -20,6 +20,9 @@ struct FrameStats {
   double view_wet_fraction = 0.0;
   std::uint32_t rain_streaks = 0;  // rain streaks drawn in this view
   double visibility_m = 0.0;       // through the fog and the rain
+  // The visible road in each state of the water model, in RoadState's order (all 0: no road in
+  // sight).
+  std::array<double, 4> road_states{};
 };
 
 struct EncodedFrame {

@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "server/render/atmosphere.hpp"
+#include "server/render/view_road_states.hpp"
 #include "server/render/view_wet_fraction.hpp"
 
 namespace downpour::session {
@@ -68,6 +69,7 @@ struct FrameScheduler::InFlight {
   std::uint32_t drops_on_glass = 0;
   double glass_wet_fraction = 0.0;
   double view_wet_fraction = 0.0;
+  std::array<double, 4> road_states{};
   std::uint32_t rain_streaks = 0;
   double visibility_m = 0.0;
   std::array<sim::TireWater, sim::kTires> tires{};
@@ -436,6 +438,8 @@ void FrameScheduler::tick(const std::shared_ptr<Session>& s, const StartedStep& 
     f.drops_on_glass = scene.windshield.drops + scene.windshield.particles;
     f.glass_wet_fraction = scene.windshield.glass_wet_fraction;
     f.view_wet_fraction = render::view_wet_fraction(views[f.view_index], scene);
+    const render::RoadStateFractions road = render::view_road_states(views[f.view_index], scene);
+    f.road_states = {road.dry, road.wet, road.drench, road.puddle};
     f.tires = scene.tires;
     readbacks_->push(readback, std::move(f));
   }
@@ -487,6 +491,7 @@ void FrameScheduler::encode(InFlight f, std::vector<std::uint8_t> pixels, double
     frame->stats.drops_on_glass = f.drops_on_glass;
     frame->stats.glass_wet_fraction = f.glass_wet_fraction;
     frame->stats.view_wet_fraction = f.view_wet_fraction;
+    frame->stats.road_states = f.road_states;
     frame->stats.rain_streaks = f.rain_streaks;
     frame->stats.visibility_m = f.visibility_m;
     frame->tires = f.tires;

@@ -109,23 +109,6 @@ double RoadSurface::height_at(double s, double lateral) const {
   return track_.surface_height(s, lateral) + relief(s, lateral);
 }
 
-Track::Projection RoadSurface::project_near(glm::dvec2 xy, double s) const {
-  // The foot of the perpendicular: move s by the offset along the tangent until it vanishes (on a
-  // curve of radius r, each step leaves an error of about lateral / r of the last).
-  TrackFrame f = track_.at(s);
-  for (int i = 0; i < 4; ++i) {
-    const glm::dvec2 tangent(f.left.y, -f.left.x);  // left is the tangent turned a quarter left
-    const double along = glm::dot(xy - glm::dvec2(f.position), tangent);
-    if (std::abs(along) < 1e-6) break;
-    s += along;
-    f = track_.at(s);
-  }
-  const double length = track_.length();
-  s = std::fmod(s, length);
-  if (s < 0.0) s += length;
-  return {s, glm::dot(xy - glm::dvec2(f.position), f.left)};
-}
-
 double RoadSurface::height(glm::dvec2 xy) const {
   const Track::Projection p = track_.project(xy, paved_half_width_ + 1.0);
   return height_at(p.s, p.lateral);

@@ -48,10 +48,9 @@ class RoadSurface {
   double height_at(double s, double lateral) const;
   // The relief below the track's section there (m, <= 0): ruts and depressions.
   double relief(double s, double lateral) const;
-  // The track's coordinates of a horizontal world position near the centreline point s_guess
-  // (within a few metres along it, as a neighbouring position's): a few Newton steps from the
-  // guess, much cheaper than a search of the whole track.
-  Track::Projection project_near(glm::dvec2 xy, double s_guess) const;
+  Track::Projection project_near(glm::dvec2 xy, double s_guess) const {
+    return track_.project_near(xy, s_guess);
+  }
   // Whether a lateral offset is on the paved width (lanes and shoulders).
   bool paved(double lateral) const;
 

@@ -26,12 +26,12 @@ RoadWater::RoadWater(const RoadSurface& surface, RoadWaterConfig config)
   outflow_.assign(count, 0.0);
 }
 
-RoadState RoadWater::state_of(double water_m) const {
-  if (water_m < config_.wet_m) return RoadState::kDry;
-  const double standing = water_m - config_.capacity_m;
-  return standing < config_.drench_m   ? RoadState::kWet
-         : standing < config_.puddle_m ? RoadState::kDrench
-                                       : RoadState::kPuddle;
+RoadState road_state(double water_m, const RoadWaterConfig& config) {
+  if (water_m < config.wet_m) return RoadState::kDry;
+  const double standing = water_m - config.capacity_m;
+  return standing < config.drench_m   ? RoadState::kWet
+         : standing < config.puddle_m ? RoadState::kDrench
+                                      : RoadState::kPuddle;
 }
 
 RoadWater::Key RoadWater::record_key(glm::ivec2 world) const {

@@ -57,6 +57,9 @@ struct RoadWaterConfig {
   double film_runoff_s = 60.0;
 };
 
+// The state of a cell holding water_m (all of it, m) under these thresholds.
+RoadState road_state(double water_m, const RoadWaterConfig& config);
+
 class RoadWater {
  public:
   RoadWater(const RoadSurface& surface, RoadWaterConfig config = {});
@@ -91,7 +94,7 @@ class RoadWater {
   const std::vector<double>& ground() const { return ground_; }
   const std::vector<double>& water() const { return water_; }
   const std::vector<std::uint8_t>& paved() const { return paved_; }
-  RoadState state_of(double water_m) const;
+  RoadState state_of(double water_m) const { return road_state(water_m, config_); }
   // The window as the renderer draws it.
   void image(RoadWaterImage& out) const;
 

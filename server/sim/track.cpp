@@ -133,4 +133,21 @@ Track::Projection Track::project(glm::dvec2 xy, double fine_within_m) const {
   return {wrap(best_s), glm::dot(xy - glm::dvec2(f.position), f.left)};
 }
 
+Track::Projection Track::project_near(glm::dvec2 xy, double s) const {
+  // The foot of the perpendicular: move s by the offset along the tangent until it vanishes (on a
+  // curve of radius r, each step leaves an error of about lateral / r of the last).
+  TrackFrame f = at(s);
+  for (int i = 0; i < 4; ++i) {
+    const glm::dvec2 tangent(f.left.y, -f.left.x);  // left is the tangent turned a quarter left
+    const double along = glm::dot(xy - glm::dvec2(f.position), tangent);
+    if (std::abs(along) < 1e-6) break;
+    s += along;
+    f = at(s);
+  }
+  const double loop = length();
+  s = std::fmod(s, loop);
+  if (s < 0.0) s += loop;
+  return {s, glm::dot(xy - glm::dvec2(f.position), f.left)};
+}
+
 }  // namespace downpour::sim

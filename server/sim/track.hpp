@@ -48,6 +48,9 @@ class Track {
   // Nearest centreline point of a horizontal position, to a few centimetres; beyond fine_within_m
   // from the centreline the answer is only as good as a 5 m sampling (cheaper, for scenery).
   Projection project(glm::dvec2 xy, double fine_within_m = 1e30) const;
+  // The same near the centreline point s_guess (within a few metres along it, as a neighbouring
+  // position's): a few Newton steps from the guess, much cheaper than a search of the whole track.
+  Projection project_near(glm::dvec2 xy, double s_guess) const;
 
  private:
   struct Segment {

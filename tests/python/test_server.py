@@ -319,14 +319,14 @@ class ServerTest(ServerProcessCase):
         self.assertGreater(cockpit.visibility_m, 1000.0)
         self.assertLess(cockpit.visibility_m, 2000.0)
 
-    def test_frames_report_the_water_under_the_tires(self):
+    def test_frames_report_the_water_under_the_tires_and_in_sight(self):
         def standing_in(rain_mm_h):
             update = pb.Update(sim_time_s=0.0)
             update.vehicle.position_m.x = 100.0
             update.vehicle.position_m.y = -1.75  # the inner lane, on the right
             update.weather.rain_rate_mm_h = rain_mm_h
             return update
-        tires = {}
+        tires, road = {}, {}
         for rain in (0.0, 200.0):
             info = self.client.create_session([view_spec("ROAD", 64, 36)], seed=7,
                                               initial=standing_in(rain))
@@ -336,6 +336,7 @@ class ServerTest(ServerProcessCase):
                 update.sim_time_s = 5.0 * step
                 frames = self.client.step(info.session_id, 5.0, update)
             tires[rain] = frames[0].tires
+            road[rain] = frames[0].stats.road_states
         self.assertEqual(len(tires[0.0]), 4)
         for tire in tires[0.0]:
             self.assertEqual(tire.state, pb.ROAD_DRY)
@@ -348,6 +349,10 @@ class ServerTest(ServerProcessCase):
             self.assertLess(tire.water_mm, 3.0)
             self.assertGreaterEqual(tire.standing_mm, 0.0)
             self.assertIn(tire.state, (pb.ROAD_WET, pb.ROAD_DRENCH, pb.ROAD_PUDDLE))
+        # The road in sight of the chase camera: all dry, then none of it.
+        self.assertEqual(road[0.0].dry, 1.0)
+        self.assertEqual(road[200.0].dry, 0.0)
+        self.assertAlmostEqual(road[200.0].wet + road[200.0].drench + road[200.0].puddle, 1.0)
 
     def test_realtime_frames_stream_to_a_watcher(self):
         session_id = self.open_session(views=[VIEWS[0]], mode=pb.MODE_REALTIME, fps=20)

@@ -1,0 +1,85 @@
+#include "server/render/view_road_states.hpp"
+
+#include <cmath>
+
+#include <glm/geometric.hpp>
+#include <glm/mat4x4.hpp>
+
+#include "server/render/camera.hpp"
+#include "server/sim/track.hpp"
+
+namespace downpour::render {
+
+namespace {
+
+constexpr double kFarM = 300.0;
+
+const sim::Track& built_in_track() {
+  static const sim::Track track = sim::Track::test_track();
+  return track;
+}
+
+}  // namespace
+
+RoadStateFractions view_road_states(const sim::ViewSpec& spec, const sim::SceneState& scene) {
+  RoadStateFractions out;
+  if ((spec.view != sim::View::kCockpit && spec.view != sim::View::kRoad) || spec.width <= 0 ||
+      spec.height <= 0) {
+    return out;
+  }
+  const sim::RoadWaterImage* image = scene.road_water.get();
+  const sim::Track& track = built_in_track();
+  const Camera camera = make_camera(spec, scene.vehicle);
+  const glm::dmat4 inverse = glm::inverse(glm::dmat4(camera.projection * camera.view));
+  const glm::dvec3 eye(camera.position);
+  // The road's plane under the car: its height there, level (the correction below adds the rest).
+  const glm::dvec2 car(scene.vehicle.position_m);
+  const sim::Track::Projection under = track.project(car, 50.0);
+  const double ground = track.surface_height(under.s, under.lateral);
+  sim::RoadWaterConfig thresholds;
+  if (image) thresholds.capacity_m = image->capacity_mm * 1e-3;
+  constexpr int kColumns = 64, kRows = 36;
+  int counts[4] = {0, 0, 0, 0};
+  for (int row = 0; row < kRows; ++row) {
+    // Neighbouring rays land near each other: each one's place on the track starts from the last
+    // one's (a few Newton steps), the first of a row from the car's.
+    double s_guess = under.s;
+    for (int col = 0; col < kColumns; ++col) {
+      const glm::dvec4 p = inverse * glm::dvec4((col + 0.5) / kColumns * 2.0 - 1.0,
+                                                1.0 - (row + 0.5) / kRows * 2.0, 0.5, 1.0);
+      const glm::dvec3 dir = glm::normalize(glm::dvec3(p) / p.w - eye);
+      if (dir.z > -1e-4) continue;  // the sky
+      double t = (ground - eye.z) / dir.z;
+      if (t <= 0.0 || t > kFarM) continue;
+      sim::Track::Projection at = track.project_near(glm::dvec2(eye + dir * t), s_guess);
+      t = (track.surface_height(at.s, at.lateral) - eye.z) / dir.z;
+      if (t <= 0.0 || t > kFarM) continue;
+      const glm::dvec3 hit = eye + dir * t;
+      at = track.project_near(glm::dvec2(hit), at.s);
+      s_guess = at.s;
+      if (std::abs(at.lateral) > track.paved_half_width()) continue;
+      double water_mm = 0.0;
+      if (image && image->cells > 0) {
+        const glm::ivec2 cell =
+            glm::ivec2(glm::floor(glm::dvec2(hit) / image->cell_m)) - image->origin;
+        const bool inside =
+            cell.x >= 0 && cell.y >= 0 && cell.x < image->cells && cell.y < image->cells;
+        water_mm =
+            inside ? image->water_standing_mm[2 * (static_cast<std::size_t>(cell.y) * image->cells +
+                                                   cell.x)]
+                   : image->mean_water_mm;
+      }
+      // (RoadState's order: dry, wet, drench, puddle.)
+      ++counts[static_cast<int>(sim::road_state(water_mm * 1e-3, thresholds))];
+    }
+  }
+  const int total = counts[0] + counts[1] + counts[2] + counts[3];
+  if (total == 0) return out;
+  out.dry = static_cast<double>(counts[0]) / total;
+  out.wet = static_cast<double>(counts[1]) / total;
+  out.drench = static_cast<double>(counts[2]) / total;
+  out.puddle = static_cast<double>(counts[3]) / total;
+  return out;
+}
+
+}  // namespace downpour::render
