@@ -89,7 +89,9 @@ sanitize() {
   cmake --build "$dir" -j "$(nproc)"
   local common="abort_on_error=1:detect_stack_use_after_return=1:strict_string_checks=1"
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-  ASAN_OPTIONS="$common" ctest --test-dir "$dir" --output-on-failure --no-tests=error -L unit
+  # The unit tests (no GL; their waits on threads have deadlines of seconds) two at a time.
+  ASAN_OPTIONS="$common" ctest --test-dir "$dir" --output-on-failure --no-tests=error -L unit \
+    -j "$(nproc)"
   # A small quarantine: the stalled-reader test bounds the server's resident memory over 3 s, and
   # ASan's default 256 MB of freed-but-held blocks goes on growing through it (17 MB once, against
   # a 16 MB bound); 16 MB fills before the test measures.
