@@ -1,6 +1,7 @@
 // downpour-server: wiring. Parses the configuration, starts the render loop (which makes the GL
 // context and renders a first frame), then serves gRPC until SIGINT or SIGTERM, and drains.
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
@@ -19,6 +20,26 @@
 #include "server/rpc/malformed_request.hpp"
 #include "server/session/frame_scheduler.hpp"
 #include "server/session/session_registry.hpp"
+
+namespace {
+
+// SIGINT and SIGTERM are blocked in every thread of ours and taken with sigtimedwait. A thread
+// that is not ours and does not block them (ThreadSanitizer's own, started before main) can still
+// receive one: with no handler, that would end the process on the spot instead of draining. The
+// handler keeps the signal for the main loop to take.
+std::atomic<int> g_caught_signal{0};
+static_assert(std::atomic<int>::is_always_lock_free, "touched from a signal handler");
+
+extern "C" void keep_signal(int number) { g_caught_signal.store(number); }
+
+// The next SIGINT or SIGTERM within `wait`, 0 if none came.
+int next_signal(const sigset_t& signals, const timespec& wait) {
+  const int number = sigtimedwait(&signals, nullptr, &wait);
+  if (number > 0) return number;
+  return g_caught_signal.exchange(0);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace downpour;
@@ -50,6 +71,11 @@ int main(int argc, char** argv) {
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  struct sigaction keep {};
+  keep.sa_handler = keep_signal;
+  sigemptyset(&keep.sa_mask);
+  sigaction(SIGINT, &keep, nullptr);
+  sigaction(SIGTERM, &keep, nullptr);
 
   session::FrameScheduler* scheduler_ptr = nullptr;
   session::SessionRegistry registry(config->max_sessions, [&scheduler_ptr] {
@@ -148,7 +174,7 @@ int main(int argc, char** argv) {
   bool serving = true;
   int signal_number = 0;
   for (;;) {
-    signal_number = sigtimedwait(&signals, nullptr, &quarter);
+    signal_number = next_signal(signals, quarter);
     if (signal_number > 0) break;
     const Clock::time_point now = Clock::now();
     const double stalled = scheduler.stalled_s(now);
@@ -195,7 +221,7 @@ int main(int argc, char** argv) {
   set_serving(false);
   const timespec poll{0, 10'000'000};
   while (service.steps_in_flight() > 0 && Clock::now() < deadline - reserve) {
-    if (sigtimedwait(&signals, nullptr, &poll) > 0) {
+    if (next_signal(signals, poll) > 0) {
       spdlog::warn("second signal: not waiting for the {} steps in flight",
                    service.steps_in_flight());
       break;
@@ -207,8 +233,7 @@ int main(int argc, char** argv) {
   // The streams send their status; one whose reader has stalled cannot, and is cancelled.
   const Clock::time_point flushed =
       std::min(Clock::now() + std::chrono::milliseconds(500), deadline);
-  while (service.open_streams() > 0 && Clock::now() < flushed)
-    sigtimedwait(&signals, nullptr, &poll);
+  while (service.open_streams() > 0 && Clock::now() < flushed) next_signal(signals, poll);
   server->Shutdown(std::chrono::system_clock::now());  // cancels what is left
   if (health_server) health_server->Shutdown(std::chrono::system_clock::now());
   scheduler.stop();
