@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <cstring>
 #include <map>
@@ -113,6 +114,20 @@ struct Mirror {
   glm::mat4 matrix{1.0f};
 };
 
+// The mirror in the plane n.p + w = 0 (n unit): x' = x - 2 (n.x + w) n.
+Mirror mirror_in(const glm::dvec4& plane) {
+  const glm::dvec3 n(plane);
+  Mirror m;
+  m.plane = glm::vec4(plane);
+  glm::dmat4 r(1.0);
+  for (int c = 0; c < 3; ++c) {
+    for (int row = 0; row < 3; ++row) r[c][row] -= 2.0 * n[row] * n[c];
+  }
+  for (int row = 0; row < 3; ++row) r[3][row] = -2.0 * plane.w * n[row];
+  m.matrix = glm::mat4(r);
+  return m;
+}
+
 Mirror mirror_under(const sim::Track& track, const sim::VehicleState& vehicle) {
   const glm::dvec2 xy(vehicle.position_m);
   const sim::Track::Projection p = track.project(xy, 50.0);
@@ -122,17 +137,7 @@ Mirror mirror_under(const sim::Track& track, const sim::VehicleState& vehicle) {
   glm::dvec3 n = glm::normalize(glm::cross(along, glm::dvec3(f.left, 0.0)));
   if (n.z < 0.0) n = -n;
   const glm::dvec3 point(xy, track.surface_height(p.s, p.lateral));
-  Mirror m;
-  const double w = -glm::dot(n, point);
-  m.plane = glm::vec4(glm::vec3(n), static_cast<float>(w));
-  // x' = x - 2 (n.x + w) n
-  glm::dmat4 r(1.0);
-  for (int c = 0; c < 3; ++c) {
-    for (int row = 0; row < 3; ++row) r[c][row] -= 2.0 * n[row] * n[c];
-  }
-  for (int row = 0; row < 3; ++row) r[3][row] = -2.0 * w * n[row];
-  m.matrix = glm::mat4(r);
-  return m;
+  return mirror_in(glm::dvec4(n, -glm::dot(n, point)));
 }
 
 GLuint unit_of(Resource r) {
@@ -189,8 +194,13 @@ struct Renderer::Impl {
   std::unique_ptr<RenderSession> image_session;  // render_image's
   RainPass* rain = nullptr;                      // one of passes
   std::uint32_t rain_streaks = 0;                // drawn by the last render()
-  // What the road reflection draws, mirrored (passes of the views), and the views that read it.
-  std::vector<Pass*> reflected;
+  // What the road reflection draws, mirrored (passes of the views), each clipped to this far above
+  // the mirror's plane; and the views that read it.
+  struct Reflected {
+    Pass* pass = nullptr;
+    float clearance_m = 0.0f;
+  };
+  std::vector<Reflected> reflected;
   std::array<bool, sim::kViewCount> reads_reflection{};
 
   template <typename Fn>
@@ -390,8 +400,6 @@ struct Renderer::Impl {
                     f.glass, f.stepped};
     mf.detail_distance_scale = kReflectionScale;
     WaterBlock clip;
-    clip.clip_plane = mirror.plane;
-    clip.clip_plane.w += 0.02f;  // what touches the road stays whole
     upload_frame_block(mf, clip);
     glBindFramebuffer(GL_FRAMEBUFFER, t.fbo.id());
     glViewport(0, 0, w, h);
@@ -401,9 +409,15 @@ struct Renderer::Impl {
     glClearNamedFramebufferfv(t.fbo.id(), GL_COLOR, 0, black);
     glClearNamedFramebufferfv(t.fbo.id(), GL_DEPTH, 0, &zero_depth);
     glEnable(GL_CLIP_DISTANCE0);
-    for (Pass* pass : reflected) {
-      apply(pass->decl().state);
-      pass->execute(mf, r);
+    for (const Reflected& pass : reflected) {
+      // Above the plane: vehicles from 2 cm under it (what touches the road stays whole), the
+      // ground from well over it. The ground under and beside the road lies in the plane: mirrored,
+      // it would be a floor over everything the mirror shows.
+      glm::vec4 plane = mirror.plane;
+      plane.w -= pass.clearance_m;
+      glNamedBufferSubData(frame_ubo.id(), offsetof(FrameBlock, clip_plane), sizeof(plane), &plane);
+      apply(pass.pass->decl().state);
+      pass.pass->execute(mf, r);
     }
     glDisable(GL_CLIP_DISTANCE0);
     r.road_reflection = {t.texture.id(), w, h};
@@ -526,7 +540,7 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   Pass* glass_water = impl->add<GlassWaterPass>();
   Pass* glass_composite = impl->add<GlassCompositePass>();
   Pass* windshield = impl->add<WindshieldPass>();
-  impl->reflected = {vehicles, terrain, sky};
+  impl->reflected = {{vehicles, -0.02f}, {terrain, 0.5f}, {sky, 0.0f}};
   auto& views = impl->views;
   views[static_cast<int>(sim::View::kCockpit)] = {
       cockpit, vehicles, road, terrain, sky, rain, glass_background, glass_water, glass_composite};
