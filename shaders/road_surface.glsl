@@ -47,7 +47,7 @@ vec3 hash3(ivec2 cell, int cycle) {
 // Ripples (seed 004): every drop that lands in a puddle starts a ring that grows toward the
 // puddle's size while it sinks and fades. Each 0.35 m cell of the world's grid holds one drop per
 // life of a ring, landing at a random point, with a probability that follows the rain rate (up to
-// about 8 rings per m^2 and second in a cloudburst). A pixel sums the rings of its 2 x 2 nearest
+// about 9 rings per m^2 and second from 25 mm/h). A pixel sums the rings of its 2 x 2 nearest
 // cells; returns the slope they give the water (world xy).
 const float kRippleCell = 0.35;
 const float kRippleLife = 0.9;  // s
@@ -86,8 +86,9 @@ vec3 from_display(vec3 c) {
   return x / max(1.0 - 0.15 * x, 0.05);
 }
 
-// What the ray r from p on the road sees in the quarter-size mirror (`sky` where it sees none): where the mirror image of the
-// pixel lies (its depth), how far along r that is, and where that point's mirror image falls.
+// What the ray r from p on the road sees in the quarter-size mirror (`sky` where it sees none):
+// where the mirror image of the pixel lies (its depth), how far along r that is, and where that
+// point's mirror image falls.
 // On the mirror's plane with its normal this is the pixel itself; a surface on a crest or in a
 // dip, tilted by the crown or moved by ripples, looks up its own reflection. The sky beyond the
 // mirror's edges.
