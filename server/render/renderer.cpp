@@ -231,10 +231,7 @@ struct Renderer::Impl {
     WaterBlock w;
     w.mirror = mirror;
     w.road_water.w = reflection ? 1.0f : 0.0f;
-    if (const sim::RoadWaterImage* image = f.scene.road_water.get();
-        image && image->cells > 0 &&
-        image->water_standing_mm.size() >=
-            static_cast<std::size_t>(image->cells) * image->cells * 2) {
+    if (const sim::RoadWaterImage* image = f.scene.road_water.get(); image && image->complete()) {
       w.road_water.x = static_cast<float>(image->origin.x * image->cell_m);
       w.road_water.y = static_cast<float>(image->origin.y * image->cell_m);
       w.road_water.z = static_cast<float>(1.0 / (image->cells * image->cell_m));
@@ -350,9 +347,7 @@ struct Renderer::Impl {
   // (one per road step: 128 x 128 cells, two half floats each).
   void upload_road_water(RenderSession::Impl& s,
                          const std::shared_ptr<const sim::RoadWaterImage>& image) {
-    const bool valid = image && image->cells > 0 &&
-                       image->water_standing_mm.size() >=
-                           static_cast<std::size_t>(image->cells) * image->cells * 2;
+    const bool valid = image && image->complete();
     const int n = valid ? image->cells : 1;
     if (!s.road_water.id() || s.road_cells != n) {
       s.road_water = make_texture_2d(GL_RG16F, n, n);
@@ -516,7 +511,7 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
 
   impl->shared = std::make_unique<SharedResources>(
-      SharedResources{sim::Track::test_track(), upload_repeating(make_noise(256, 1), true),
+      SharedResources{sim::Track::built_in(), upload_repeating(make_noise(256, 1), true),
                       upload_repeating(make_asphalt_relief(512, 2), true), FullscreenTriangle()});
   glBindTextureUnit(texture_unit::kNoise, impl->shared->noise.id());
   glBindTextureUnit(texture_unit::kAsphalt, impl->shared->asphalt.id());

@@ -14,11 +14,6 @@ namespace {
 
 constexpr double kFarM = 300.0;
 
-const sim::Track& built_in_track() {
-  static const sim::Track track = sim::Track::test_track();
-  return track;
-}
-
 }  // namespace
 
 RoadStateFractions view_road_states(const sim::ViewSpec& spec, const sim::SceneState& scene) {
@@ -28,7 +23,7 @@ RoadStateFractions view_road_states(const sim::ViewSpec& spec, const sim::SceneS
     return out;
   }
   const sim::RoadWaterImage* image = scene.road_water.get();
-  const sim::Track& track = built_in_track();
+  const sim::Track& track = sim::Track::built_in();
   const Camera camera = make_camera(spec, scene.vehicle);
   const glm::dmat4 inverse = glm::inverse(glm::dmat4(camera.projection * camera.view));
   const glm::dvec3 eye(camera.position);
@@ -59,7 +54,7 @@ RoadStateFractions view_road_states(const sim::ViewSpec& spec, const sim::SceneS
       s_guess = at.s;
       if (std::abs(at.lateral) > track.paved_half_width()) continue;
       double water_mm = 0.0;
-      if (image && image->cells > 0) {
+      if (image && image->complete()) {
         const glm::ivec2 cell =
             glm::ivec2(glm::floor(glm::dvec2(hit) / image->cell_m)) - image->origin;
         const bool inside =

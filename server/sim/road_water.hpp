@@ -9,6 +9,7 @@
 // S0 * 2^level around the car); the coarser rings are to come.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <utility>
@@ -34,6 +35,11 @@ struct RoadWaterImage {
   // it.
   float mean_water_mm = 0.0f;
   float mean_standing_mm = 0.0f;
+
+  // Whether it holds its cells' water (a default one does not).
+  bool complete() const {
+    return cells > 0 && water_standing_mm.size() >= static_cast<std::size_t>(cells) * cells * 2;
+  }
 };
 
 struct RoadWaterConfig {

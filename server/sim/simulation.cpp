@@ -10,16 +10,6 @@
 
 namespace downpour::sim {
 
-namespace {
-
-// The built-in track, made once for every session (the road's relief is per seed).
-const Track& test_track() {
-  static const Track track = Track::test_track();
-  return track;
-}
-
-}  // namespace
-
 Simulation::Simulation(std::uint64_t seed, const Update& initial, SimulationConfig config)
     : config_(config),
       seed_(seed),
@@ -28,7 +18,7 @@ Simulation::Simulation(std::uint64_t seed, const Update& initial, SimulationConf
       rain_(seed, config.rain),
       water_map_(config.windshield.glass, config.water_map),
       blades_at_water_step_(wipers_.poses()),
-      surface_(std::make_shared<const RoadSurface>(test_track(), seed)),
+      surface_(std::make_shared<const RoadSurface>(Track::built_in(), seed)),
       road_(*surface_, config.road) {
   state_.glass = config_.windshield.glass;
   apply(initial);
@@ -43,11 +33,11 @@ void Simulation::publish() {
   rain_ms_ +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   state_.windshield.glass_wet_fraction = state_.windshield.map.wet_fraction;
-  if (road_steps_ != road_steps_published_ || !state_.road_water) {
+  if (road_image_stale_ || !state_.road_water) {
     auto image = std::make_shared<RoadWaterImage>();
     road_.image(*image);
     state_.road_water = std::move(image);
-    road_steps_published_ = road_steps_;
+    road_image_stale_ = false;
   }
   // Under each tire: front left, front right, rear left, rear right.
   const glm::dmat4 to_world = vehicle_to_world(state_.vehicle);
@@ -133,7 +123,7 @@ void Simulation::sub_step() {
     road_.step(glm::dvec2(state_.vehicle.position_m), state_.weather.rain_rate_mm_h,
                sub_steps_since_road_ * config_.sub_step_s);
     sub_steps_since_road_ = 0;
-    ++road_steps_;
+    road_image_stale_ = true;
     road_ms_ +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0).count();
   }

@@ -95,8 +95,7 @@ class Simulation {
   std::shared_ptr<const RoadSurface> surface_;
   RoadWater road_;
   int sub_steps_since_road_ = 0;
-  std::uint64_t road_steps_ = 0;
-  std::uint64_t road_steps_published_ = 0;
+  bool road_image_stale_ = true;  // a road step since state_.road_water was made
   AdvanceTiming timing_;
   double rain_ms_ = 0.0;  // the rain field's time in this advance, so far
   double road_ms_ = 0.0;  // the road water's, likewise

@@ -150,4 +150,9 @@ Track::Projection Track::project_near(glm::dvec2 xy, double s) const {
   return {s, glm::dot(xy - glm::dvec2(f.position), f.left)};
 }
 
+const Track& Track::built_in() {
+  static const Track track = test_track();
+  return track;
+}
+
 }  // namespace downpour::sim

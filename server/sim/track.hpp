@@ -28,6 +28,8 @@ class Track {
   // About 3.4 km: two 900 m straights joined by two 250 m radius half circles; a 10 m crest on the
   // back straight.
   static Track test_track();
+  // The same, made once and shared (sessions, the renderer's stats, test fixtures).
+  static const Track& built_in();
 
   double length() const { return length_; }
   const CrossSection& cross_section() const { return section_; }

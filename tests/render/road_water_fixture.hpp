@@ -36,7 +36,7 @@ inline std::vector<HandPuddle> test_puddles() {
 inline std::shared_ptr<const sim::RoadWaterImage> hand_road_water(
     const sim::VehicleState& car, double standing_mm, const std::vector<HandPuddle>& puddles = {},
     double capacity_mm = 0.5) {
-  static const sim::Track track = sim::Track::test_track();
+  const sim::Track& track = sim::Track::built_in();
   auto image = std::make_shared<sim::RoadWaterImage>();
   const sim::RoadWaterConfig config;
   image->cell_m = config.cell_m;
