@@ -22,29 +22,33 @@ using namespace downpour;
 
 namespace {
 
-constexpr int kScale = 4;
-
+// The rings' water over the coarsest window, a pixel per finest cell (the finest cell that holds
+// each place), +y up.
 void picture(const sim::RoadWater& water, const sim::RoadSurface& surface,
              const std::string& path) {
-  const int n = water.cells();
-  testing::RgbaImage image{n * kScale, n * kScale, {}};
-  image.pixels.assign(static_cast<std::size_t>(image.width) * image.height * 4, 255);
+  const int levels = water.levels();
+  const double cell = water.cell_m(0);
+  const int side = water.cells() << (levels - 1);
+  const glm::dvec2 corner = glm::dvec2(water.origin(levels - 1)) * water.cell_m(levels - 1);
+  testing::RgbaImage image{side, side, {}};
+  image.pixels.assign(static_cast<std::size_t>(side) * side * 4, 255);
   const sim::Track& track = surface.track();
-  const double cell = water.config().cell_m;
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i < n; ++i) {
-      const std::size_t c = static_cast<std::size_t>(j) * n + i;
+  double s_guess = track.project(corner + 0.5 * side * cell, 40.0).s;
+  for (int j = 0; j < side; ++j) {
+    for (int i = 0; i < side; ++i) {
+      const glm::dvec2 xy = corner + (glm::dvec2(i, j) + 0.5) * cell;
+      const sim::Track::Projection p = track.project_near(xy, s_guess);
+      if (i == 0) s_guess = p.s;
       double rgb[3];
-      if (!water.paved()[c]) {
+      if (!surface.paved(p.lateral)) {
         rgb[0] = 0.35, rgb[1] = 0.5, rgb[2] = 0.3;
       } else {
-        const glm::dvec2 xy = (glm::dvec2(water.origin() + glm::ivec2(i, j)) + 0.5) * cell;
-        const sim::Track::Projection p = track.project(xy, 40.0);
         const double relief = surface.relief(p.s, p.lateral);  // <= 0
         const double grey = 0.75 + std::max(relief, -0.03) * 12.0;
         rgb[0] = rgb[1] = rgb[2] = grey;
-        const double w = water.water()[c];
-        switch (water.state_of(w)) {
+        const double w = water.water_m(xy);
+        const int c = water.cell_at(xy);
+        switch (c < 0 ? sim::RoadState::kDry : water.cell_state(static_cast<std::size_t>(c))) {
           case sim::RoadState::kDry:
             break;
           case sim::RoadState::kWet:
@@ -60,15 +64,10 @@ void picture(const sim::RoadWater& water, const sim::RoadSurface& surface,
           }
         }
       }
-      for (int y = 0; y < kScale; ++y) {
-        for (int x = 0; x < kScale; ++x) {
-          // Rows top-down: +y up.
-          const int row = (n - 1 - j) * kScale + y, col = i * kScale + x;
-          std::uint8_t* px = &image.pixels[(static_cast<std::size_t>(row) * image.width + col) * 4];
-          for (int k = 0; k < 3; ++k)
-            px[k] = static_cast<std::uint8_t>(std::clamp(rgb[k], 0.0, 1.0) * 255.0);
-        }
-      }
+      std::uint8_t* px =
+          &image.pixels[(static_cast<std::size_t>(side - 1 - j) * image.width + i) * 4];
+      for (int k = 0; k < 3; ++k)
+        px[k] = static_cast<std::uint8_t>(std::clamp(rgb[k], 0.0, 1.0) * 255.0);
     }
   }
   testing::write_png(path, image);
@@ -107,11 +106,17 @@ int main(int argc, char** argv) {
     }
   };
   auto report = [&](const char* name, double speed) {
-    int counts[4] = {0, 0, 0, 0}, paved = 0;
+    // The paved area in each state (m^2), of the finest ring's cells in puddles.
+    double counts[4] = {0.0, 0.0, 0.0, 0.0}, paved = 0.0;
+    int puddle_cells = 0;
+    const std::size_t per_level = static_cast<std::size_t>(water.cells()) * water.cells();
     for (std::size_t c = 0; c < water.water().size(); ++c) {
-      if (!water.paved()[c]) continue;
-      ++paved;
-      ++counts[static_cast<int>(water.state_of(water.water()[c]))];
+      if (!water.paved()[c] || !water.owned()[c]) continue;
+      const double size = water.cell_m(static_cast<int>(c / per_level));
+      const sim::RoadState state = water.cell_state(c);
+      paved += size * size;
+      counts[static_cast<int>(state)] += size * size;
+      puddle_cells += c < per_level && state == sim::RoadState::kPuddle;
     }
     const sim::RoadWater::Ledger& l = water.ledger();
     const double closure =
@@ -124,10 +129,9 @@ int main(int argc, char** argv) {
         "\"drench\": %.3f, \"puddle\": %.3f, \"puddle_cells\": %d, \"rain_in_m3\": %.4f, "
         "\"stored_m3\": %.4f, \"drained_m3\": %.4f, \"evaporated_m3\": %.6f, "
         "\"ledger_closure\": %.2e, \"step_ms\": %.3f, \"step_ms_p90\": %.3f}\n",
-        name, t, speed, counts[0] / double(paved), counts[1] / double(paved),
-        counts[2] / double(paved), counts[3] / double(paved), counts[3], l.rain_in_m3,
-        water.stored_m3(), l.drained_m3, l.evaporated_m3, closure, bench::median(ms),
-        bench::percentile(ms, 0.9));
+        name, t, speed, counts[0] / paved, counts[1] / paved, counts[2] / paved, counts[3] / paved,
+        puddle_cells, l.rain_in_m3, water.stored_m3(), l.drained_m3, l.evaporated_m3, closure,
+        bench::median(ms), bench::percentile(ms, 0.9));
     ms.clear();
     if (!out.empty()) picture(water, surface, out + "/" + name + ".png");
   };

@@ -21,16 +21,28 @@ float stripe(float x, float c, float hw) {
   return clamp((hw - abs(x - c)) / w + 0.5, 0.0, 1.0);
 }
 
-// The water at xy: x all of it (mm), y the part standing above the texture (mm). From the road's
-// water window where it reaches, fading over its last 2 m to the window's mean; without a window,
-// the weather's wetness alone.
+// The water at xy: x all of it (mm), y the part standing above the texture (mm). From the finest
+// of the water's rings that holds it, each ring fading out over its last 4 cells to the coarser one
+// under it (whose cells there hold the finer ones' means), the last one to the rings' mean; without
+// rings, the weather's wetness alone. Fine to coarse, done at the first ring that holds xy whole
+// (one lookup, two in a ring's fading band).
 vec2 water_at(vec2 xy) {
   float wet = frame.params.z;
   if (frame.road_water_state.w == 0.0) return vec2(wet * 0.5, wet * wet * 0.15);
-  vec2 uv = (xy - frame.road_water.xy) * frame.road_water.z;
-  vec2 edge_m = min(uv, 1.0 - uv) / frame.road_water.z;
-  float inside = clamp(min(edge_m.x, edge_m.y) * 0.5, 0.0, 1.0);
-  return mix(frame.road_water_state.yz, texture(road_water_tex, uv).rg, inside);
+  vec2 water = vec2(0.0);
+  float rest = 1.0;
+  int rings = int(frame.road_water.x);
+  for (int l = 0; l < rings && rest > 0.0; ++l) {
+    vec4 ring = frame.road_water_rings[l];
+    vec2 uv = (xy - ring.xy) * ring.z;
+    vec2 edge_m = min(uv, 1.0 - uv) / ring.z;
+    float inside = clamp(min(edge_m.x, edge_m.y) / (4.0 * ring.w), 0.0, 1.0);
+    if (inside > 0.0) {
+      water += rest * inside * texture(road_water_tex, vec3(uv, float(l))).rg;
+      rest *= 1.0 - inside;
+    }
+  }
+  return water + rest * frame.road_water_state.yz;
 }
 
 #ifdef ROAD_RIPPLES

@@ -38,6 +38,15 @@ Texture make_texture_2d(GLenum internal_format, int width, int height, int level
   return Texture(id);
 }
 
+Texture make_texture_2d_array(GLenum internal_format, int width, int height, int layers) {
+  GLuint id = 0;
+  glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
+  glTextureStorage3D(id, 1, internal_format, width, height, layers);
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  return Texture(id);
+}
+
 ShaderProgram::ShaderProgram(const std::string& vertex_file, const std::string& fragment_file)
     : files_(vertex_file + " + " + fragment_file) {
   const GLuint vs = compile(GL_VERTEX_SHADER, vertex_file);

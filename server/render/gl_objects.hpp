@@ -54,6 +54,8 @@ using Framebuffer = GlName<gl_delete::framebuffer>;
 using VertexArray = GlName<gl_delete::vertex_array>;
 
 Texture make_texture_2d(GLenum internal_format, int width, int height, int levels = 1);
+// Layers of one size, filtered linearly within a layer.
+Texture make_texture_2d_array(GLenum internal_format, int width, int height, int layers);
 
 // A uniform's location in a program, looked up once (when the pass is made) and set by handle.
 class Uniform {

@@ -173,7 +173,7 @@ struct RenderSession::Impl {
   std::uint64_t water_stamp = 0;
   // The road's water window on the GPU and the image it shows (held, so that its address names it).
   Texture road_water;
-  int road_cells = 0;
+  int road_cells = 0, road_rings = 0;
   std::shared_ptr<const sim::RoadWaterImage> road_shown;
   bool road_dry_shown = false;
 };
@@ -224,6 +224,7 @@ struct Renderer::Impl {
     Mirror mirror;
     glm::vec4 clip_plane{0.0f, 0.0f, 0.0f, 1.0f};
     glm::vec4 road_water{0.0f};
+    glm::mat4 road_water_rings{0.0f};
     glm::vec4 road_water_state{0.5f, 0.0f, 0.0f, 0.0f};
   };
 
@@ -232,9 +233,14 @@ struct Renderer::Impl {
     w.mirror = mirror;
     w.road_water.w = reflection ? 1.0f : 0.0f;
     if (const sim::RoadWaterImage* image = f.scene.road_water.get(); image && image->complete()) {
-      w.road_water.x = static_cast<float>(image->origin.x * image->cell_m);
-      w.road_water.y = static_cast<float>(image->origin.y * image->cell_m);
-      w.road_water.z = static_cast<float>(1.0 / (image->cells * image->cell_m));
+      w.road_water.x = static_cast<float>(image->levels);
+      for (int l = 0; l < image->levels; ++l) {
+        const double cell = image->level_cell_m(l);
+        w.road_water_rings[l] =
+            glm::vec4(static_cast<float>(image->origins[l].x * cell),
+                      static_cast<float>(image->origins[l].y * cell),
+                      static_cast<float>(1.0 / (image->cells * cell)), static_cast<float>(cell));
+      }
       w.road_water_state = glm::vec4(static_cast<float>(image->capacity_mm), image->mean_water_mm,
                                      image->mean_standing_mm, 1.0f);
     }
@@ -262,6 +268,7 @@ struct Renderer::Impl {
     b.mirror_view_proj = b.view_proj * water.mirror.matrix;
     b.clip_plane = water.clip_plane;
     b.road_water = water.road_water;
+    b.road_water_rings = water.road_water_rings;
     b.road_water_state = water.road_water_state;
     glNamedBufferSubData(frame_ubo.id(), 0, sizeof(b), &b);
   }
@@ -343,24 +350,25 @@ struct Renderer::Impl {
     s.water_stamp = map.stamp;
   }
 
-  // The session's road water window brought up to the frame's: a whole upload for each new image
-  // (one per road step: 128 x 128 cells, two half floats each).
+  // The session's road water rings brought up to the frame's: a whole upload for each new image
+  // (one per road step: 4 rings of 64 x 64 cells, two half floats each).
   void upload_road_water(RenderSession::Impl& s,
                          const std::shared_ptr<const sim::RoadWaterImage>& image) {
     const bool valid = image && image->complete();
-    const int n = valid ? image->cells : 1;
-    if (!s.road_water.id() || s.road_cells != n) {
-      s.road_water = make_texture_2d(GL_RG16F, n, n);
+    const int n = valid ? image->cells : 1, rings = valid ? image->levels : 1;
+    if (!s.road_water.id() || s.road_cells != n || s.road_rings != rings) {
+      s.road_water = make_texture_2d_array(GL_RG16F, n, n, rings);
       glTextureParameteri(s.road_water.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
       glTextureParameteri(s.road_water.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
       s.road_cells = n;
+      s.road_rings = rings;
       s.road_shown.reset();
       s.road_dry_shown = false;
     }
     if (!valid) {
       if (!s.road_dry_shown) {
         const float dry[2] = {0.0f, 0.0f};
-        glTextureSubImage2D(s.road_water.id(), 0, 0, 0, 1, 1, GL_RG, GL_FLOAT, dry);
+        glTextureSubImage3D(s.road_water.id(), 0, 0, 0, 0, 1, 1, 1, GL_RG, GL_FLOAT, dry);
         s.road_dry_shown = true;
         s.road_shown.reset();
       }
@@ -368,7 +376,7 @@ struct Renderer::Impl {
     }
     if (s.road_shown == image) return;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTextureSubImage2D(s.road_water.id(), 0, 0, 0, n, n, GL_RG, GL_FLOAT,
+    glTextureSubImage3D(s.road_water.id(), 0, 0, 0, 0, n, n, rings, GL_RG, GL_FLOAT,
                         image->water_standing_mm.data());
     s.road_shown = image;
     s.road_dry_shown = false;

@@ -10,23 +10,23 @@
 namespace downpour::render {
 
 // Texture units: X(C++ name, unit, GLSL sampler type, GLSL name, what it holds).
-#define DOWNPOUR_TEXTURE_UNITS(X)                                                                \
-  X(kNoise, 1, sampler2D, noise_tex, "value noise, 4 frequencies in rgba, repeating")            \
-  X(kAsphalt, 2, sampler2D, asphalt_tex, "asphalt relief: rgb normal, a height (seed 003, 3.1)") \
-  X(kGlassWater, 3, sampler2D, glass_water_tex,                                                  \
-    "the session's glass water map: normal uv, compressed height, coverage")                     \
-  X(kSceneBlur, 4, sampler2D, scene_blur_tex,                                                    \
-    "the scene outside the glass, an eighth of the view, mirrored repeat")                       \
-  X(kViewColour, 5, sampler2D, view_colour_tex, "the view's colour so far")                      \
-  X(kViewDepth, 6, sampler2D, view_depth_tex, "the view's depth so far (reversed-Z)")            \
-  X(kGlassLayer, 7, sampler2D, glass_layer_tex,                                                  \
-    "the water on the glass over the scene, reduced size, premultiplied")                        \
-  X(kRainLayer, 8, sampler2D, rain_layer_tex,                                                    \
-    "the rain streaks, reduced size, premultiplied (rain_layer.hpp)")                            \
-  X(kRoadWater, 9, sampler2D, road_water_tex,                                                    \
-    "the road's water around the car: r water, g standing water (mm), per 0.25 m cell")          \
-  X(kReflection, 10, sampler2D, reflection_tex,                                                  \
-    "the scene mirrored in the road's plane, reduced size, mipmapped (display-encoded)")         \
+#define DOWNPOUR_TEXTURE_UNITS(X)                                                                 \
+  X(kNoise, 1, sampler2D, noise_tex, "value noise, 4 frequencies in rgba, repeating")             \
+  X(kAsphalt, 2, sampler2D, asphalt_tex, "asphalt relief: rgb normal, a height (seed 003, 3.1)")  \
+  X(kGlassWater, 3, sampler2D, glass_water_tex,                                                   \
+    "the session's glass water map: normal uv, compressed height, coverage")                      \
+  X(kSceneBlur, 4, sampler2D, scene_blur_tex,                                                     \
+    "the scene outside the glass, an eighth of the view, mirrored repeat")                        \
+  X(kViewColour, 5, sampler2D, view_colour_tex, "the view's colour so far")                       \
+  X(kViewDepth, 6, sampler2D, view_depth_tex, "the view's depth so far (reversed-Z)")             \
+  X(kGlassLayer, 7, sampler2D, glass_layer_tex,                                                   \
+    "the water on the glass over the scene, reduced size, premultiplied")                         \
+  X(kRainLayer, 8, sampler2D, rain_layer_tex,                                                     \
+    "the rain streaks, reduced size, premultiplied (rain_layer.hpp)")                             \
+  X(kRoadWater, 9, sampler2DArray, road_water_tex,                                                \
+    "the road's water in rings around the car, a layer per ring: r water, g standing water (mm)") \
+  X(kReflection, 10, sampler2D, reflection_tex,                                                   \
+    "the scene mirrored in the road's plane, reduced size, mipmapped (display-encoded)")          \
   X(kReflectionDepth, 11, sampler2D, reflection_depth_tex, "its depth (reversed-Z)")
 
 // The per-frame uniform block: X(GLSL type, name, comment). Every field is a vec4 or a mat4, so
@@ -45,9 +45,10 @@ namespace downpour::render {
   X(vec4, wind, "xy wind velocity (m/s, world)")                                              \
   X(mat4, mirror_view_proj, "world to the reflection's clip: view_proj times the mirror")     \
   X(vec4, clip_plane, "what is drawn: n.p + w >= 0 (the road reflection's, else everything)") \
-  X(vec4, road_water,                                                                         \
-    "xy the water window's lower-left corner (world m), z 1 / its side (m), "                 \
-    "w 1 with a reflection drawn, else 0")                                                    \
+  X(vec4, road_water, "x the water's rings (0: none), w 1 with a reflection drawn, else 0")   \
+  X(mat4, road_water_rings,                                                                   \
+    "column l: ring l's window, xy its lower-left corner (world m), z 1 / its side (m), "     \
+    "w its cell (m)")                                                                         \
   X(vec4, road_water_state,                                                                   \
     "x capacity (mm), y z the window's mean water and standing water "                        \
     "(mm), w 1 with the window, else 0 (the wetness alone)")

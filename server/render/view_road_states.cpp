@@ -54,16 +54,7 @@ RoadStateFractions view_road_states(const sim::ViewSpec& spec, const sim::SceneS
       s_guess = at.s;
       if (std::abs(at.lateral) > track.paved_half_width()) continue;
       double water_mm = 0.0;
-      if (image && image->complete()) {
-        const glm::ivec2 cell =
-            glm::ivec2(glm::floor(glm::dvec2(hit) / image->cell_m)) - image->origin;
-        const bool inside =
-            cell.x >= 0 && cell.y >= 0 && cell.x < image->cells && cell.y < image->cells;
-        water_mm =
-            inside ? image->water_standing_mm[2 * (static_cast<std::size_t>(cell.y) * image->cells +
-                                                   cell.x)]
-                   : image->mean_water_mm;
-      }
+      if (image && image->complete()) water_mm = image->at(glm::dvec2(hit)).x;
       // (RoadState's order: dry, wet, drench, puddle.)
       ++counts[static_cast<int>(sim::road_state(water_mm * 1e-3, thresholds))];
     }

@@ -1,17 +1,26 @@
 // The water on the road (seed 003's water model): rain fills the surface's texture, then stands and
 // runs downhill by water level (ground + standing water) to the four neighbours, pools in ruts and
-// bowls, and leaves the road at the paved edge; when the rain stops it evaporates. Cells are
-// squares of the world's grid in a window that follows the car, so water stays where it fell: a
-// cell that leaves the window gives its water to a coarse record, from which the cells take it back
-// when they return. Every cubic metre is accounted for (Ledger). No GL.
+// bowls, and leaves the road at the paved edge; when the rain stops it evaporates. No GL.
 //
-// This is the finest level of the level-of-detail rings the issue asks for (square rings of
-// S0 * 2^level around the car); the coarser rings are to come.
+// Cells are squares of the world's grid in level-of-detail rings around the car: level l has cells
+// of cell_m * 2^l in a window of `cells` x `cells` of them, each window twice the last one's side
+// and aligned to the next level's cells, so that every place belongs to the finest window that
+// holds it (the rings: the finest window, then the part of each coarser one outside the finer).
+// Water runs between the cells of a level and across a ring's border between a fine cell and its
+// coarse neighbour. When the car moves, the windows move with it, coarse to fine: a place leaving a
+// fine ring gives its water to the coarser cell that now holds it; a coarse cell entering a finer
+// ring shares its water out to its finer cells, the texture first, then the standing water to the
+// lowest of them, so puddles form again in the ruts and bowls as the car comes near. Water stays
+// where it fell in the world: a coarsest cell leaving the last window keeps its water in a record,
+// from which it is shared out again when the window comes back. Every cubic metre is accounted for
+// (Ledger).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -22,31 +31,44 @@
 
 namespace downpour::sim {
 
-// The window's water as the renderer draws it: per cell, rows along +y, the water on the surface
-// and the part of it standing above the texture, both in mm (floats, 2 per cell).
+inline constexpr int kRoadWaterMaxLevels = 4;
+
+// The rings' water as the renderer draws it: per level, per cell, rows along +y, the water on the
+// surface as the cell's state sees it (RoadWater::sheet_m) and the part of all of it standing above
+// the texture, both in mm (floats, 2 per cell). A cell inside a finer ring holds the mean of its
+// finer cells, so that a lookup filtered across a ring's border blends what is there.
 struct RoadWaterImage {
-  glm::ivec2 origin{0};  // the window's lower-left cell in the world's grid (RoadWater::origin)
-  double cell_m = 0.25;
-  int cells = 0;  // per side
+  int levels = 0;
+  std::array<glm::ivec2, kRoadWaterMaxLevels> origins{};  // each window's lower-left cell in its
+                                                          // level's grid (RoadWater::origin)
+  double cell_m = 0.25;  // the finest level's; level l's is cell_m * 2^l
+  int cells = 0;         // per side, every level
   double capacity_mm = 0.5;
-  std::vector<float> water_standing_mm;
+  std::vector<float> water_standing_mm;  // [((level * cells + row) * cells + column) * 2 + k]
   float max_standing_mm = 0.0f;
-  // Over the paved cells: what the road beyond the window is drawn with, until coarser rings hold
-  // it.
+  // Over the paved cells (by area): what the road beyond the last window is drawn with.
   float mean_water_mm = 0.0f;
   float mean_standing_mm = 0.0f;
 
   // Whether it holds its cells' water (a default one does not).
   bool complete() const {
-    return cells > 0 && water_standing_mm.size() >= static_cast<std::size_t>(cells) * cells * 2;
+    return cells > 0 && levels > 0 && levels <= kRoadWaterMaxLevels &&
+           water_standing_mm.size() >= static_cast<std::size_t>(levels) * cells * cells * 2;
   }
+  double level_cell_m(int level) const { return cell_m * static_cast<double>(1 << level); }
+  // Water and standing water (mm) at a world position: the finest level that holds it, else the
+  // means. Requires complete().
+  glm::vec2 at(glm::dvec2 xy) const;
 };
 
 struct RoadWaterConfig {
   // S0: a drop's wet spot is a centimetre or two; cells that small around a car would be millions,
   // so the finest cell is a quarter of a metre, finer than a rut (0.7 m wide) or a bowl.
   double cell_m = 0.25;
-  int cells = 128;  // the window's side in cells (32 m)
+  // Every level's window side in cells (a multiple of 8, 48 or more): 16 m of 0.25 m cells, then
+  // 32, 64 and 128 m of 0.5, 1 and 2 m cells.
+  int cells = 64;
+  int levels = 4;  // 1 to kRoadWaterMaxLevels
   // What the asphalt's texture holds before water stands on it (macrotexture depth of a dense
   // asphalt is 0.4-1 mm; a film of about half of it fills the pores).
   double capacity_m = 0.0005;
@@ -57,10 +79,12 @@ struct RoadWaterConfig {
   // Evaporation from a wet road once the rain stops: a few tenths of a millimetre an hour under
   // cloud, more in sun and wind and with traffic; none while it rains (the air is saturated).
   double evaporation_m_per_s = 0.4e-3 / 3600.0;
-  double record_m = 2.0;  // the coarse records' cells (a whole number of cells)
-  // Out of the window a film keeps running off the road: the time constant of what is left (a film
-  // crosses a half-width of 8 m at about 0.1 m/s).
+  // Out of the windows a film keeps running off the road: the time constant of what is left (a
+  // film crosses a half-width of 8 m at about 0.1 m/s). A puddle's water stays.
   double film_runoff_s = 60.0;
+  // The records kept out of the windows (one per coarsest cell the road's water left): past this
+  // many, the farther half is let go (counted as drained: 2 m cells, 100 km of a 16 m road).
+  std::size_t max_records = 400000;
 };
 
 // The state of a cell holding water_m (all of it, m) under these thresholds.
@@ -70,75 +94,138 @@ class RoadWater {
  public:
   RoadWater(const RoadSurface& surface, RoadWaterConfig config = {});
 
-  // Centres the window on `centre` (world, m), then advances dt_s under rain_mm_h.
+  // The rings' windows around `centre` (world, m): each level's lower-left cell in its grid, on a
+  // multiple of 8 cells (on a cell of the next level's grid, so that a coarse cell is either
+  // wholly in the finer window or wholly out of it).
+  static std::array<glm::ivec2, kRoadWaterMaxLevels> ring_origins(glm::dvec2 centre, double cell_m,
+                                                                  int cells, int levels);
+
+  // Centres the windows on `centre` (world, m), then advances dt_s under rain_mm_h.
   void step(glm::dvec2 centre, double rain_mm_h, double dt_s);
 
-  // At a world position in the window (else 0): all water on the surface (m of depth),
-  // and the part standing above the texture (state_of gives the state).
+  // At a world position, from the finest cell that holds it (0 out of the windows): all water on
+  // the surface (m of depth), and the part standing above the texture (state_of gives the state).
   double water_m(glm::dvec2 xy) const;
   double standing_m(glm::dvec2 xy) const;
+  // The cell that holds xy's water (an index of water()), -1 outside the windows.
+  int cell_at(glm::dvec2 xy) const { return find(xy); }
   // Takes up to volume_m3 from the cell at xy (spray); returns what it took.
   double take(glm::dvec2 xy, double volume_m3);
 
   struct Ledger {
     double rain_in_m3 = 0.0;
-    double drained_m3 = 0.0;     // off the paved edge
-    double evaporated_m3 = 0.0;  // in the window and in the records
+    double drained_m3 = 0.0;     // off the paved edge (and records let go)
+    double evaporated_m3 = 0.0;  // in the windows and in the records
     double thrown_m3 = 0.0;      // taken (spray)
   };
   const Ledger& ledger() const { return ledger_; }
-  // Water held in the window and in the records (m^3): rain in = stored + drained + evaporated +
+  // Water held in the windows and in the records (m^3): rain in = stored + drained + evaporated +
   // thrown.
   double stored_m3() const;
 
   const RoadWaterConfig& config() const { return config_; }
+  int levels() const { return levels_; }
   int cells() const { return n_; }
-  // The window's lower-left cell, in cells of the world's grid (cell (i, j) spans
-  // [i, i + 1) x [j, j + 1) times cell_m).
-  glm::ivec2 origin() const { return origin_; }
-  // Per cell of the window, rows along +y: ground height (m), water (m), whether paved.
+  double cell_m(int level) const { return config_.cell_m * static_cast<double>(1 << level); }
+  // A level's window's lower-left cell in that level's grid (cell (i, j) of level l spans
+  // [i, i + 1) x [j, j + 1) times cell_m(l)).
+  glm::ivec2 origin(int level) const { return origins_[level]; }
+  // Per cell of every level, [(level * cells + j) * cells + i]: ground height (m), water (m; 0 in
+  // a cell a finer ring holds), whether paved, whether the cell holds its place's water (it lies
+  // in no finer window).
   const std::vector<double>& ground() const { return ground_; }
   const std::vector<double>& water() const { return water_; }
   const std::vector<std::uint8_t>& paved() const { return paved_; }
+  const std::vector<std::uint8_t>& owned() const { return owned_; }
+  const std::vector<double>& hollow() const { return hollow_; }  // (m, see hollow_)
+  std::size_t records() const { return records_.size(); }
   RoadState state_of(double water_m) const { return road_state(water_m, config_); }
-  // The window as the renderer draws it.
+  // A cell's water as its state sees it (m): a coarse cell's without what its hollows hold (its
+  // ruts full, the rest of it under a film is not a puddle), and its state.
+  double sheet_m(std::size_t c) const {
+    return c < layer()
+               ? water_[c]
+               : water_[c] - std::min(std::max(water_[c] - config_.capacity_m, 0.0), hollow_[c]);
+  }
+  RoadState cell_state(std::size_t c) const { return state_of(sheet_m(c)); }
+  // The rings as the renderer draws them.
   void image(RoadWaterImage& out) const;
 
  private:
   struct Record {
-    double volume_m3 = 0.0;   // held in the texture (or a puddle's)
-    double film_m3 = 0.0;     // standing as a film: it runs off while out of the window
-    int cells_out = 0;        // of its cells, those outside the window with their water here
+    double texture_m3 = 0.0;  // held in the texture
+    double film_m3 = 0.0;     // standing as a film: it runs off while out of the windows
+    double pooled_m3 = 0.0;   // standing in puddles: it stays
+    double paved_m2 = 0.0;    // the paved area it came from (evaporation's)
     double dry_time_s = 0.0;  // dry_time_s_ when it was last settled
     double time_s = 0.0;      // time_s_ then
   };
   using Key = std::pair<int, int>;
+  // Where the water of a place came from, for the cells that share it out when a window moves.
+  struct Source {
+    int level = -1;  // the old cell's level, or -1: a record (or the road the windows never saw)
+    glm::ivec2 cell{0};
+    bool operator<(const Source& o) const {
+      return std::tie(level, cell.x, cell.y) < std::tie(o.level, o.cell.x, o.cell.y);
+    }
+  };
 
-  void move_to(glm::ivec2 origin);
-  // A cell entering the window: its water from its record, or, for a cell the window has not
-  // seen, `fresh_m` (the rain that fell there before: as the window's cells have it).
-  void fill_cell(int i, int j, glm::ivec2 world, double s_guess, double fresh_m);
-  void leave_cell(int i, int j);  // a cell leaving it
-  Key record_key(glm::ivec2 world) const;
-  // Brings a record to now: its film runs off (film_runoff_s), then the rest evaporates.
+  std::size_t flat(int level, int i, int j) const {
+    return (static_cast<std::size_t>(level) * n_ + j) * n_ + i;
+  }
+  bool inside(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origins, int level,
+              glm::ivec2 cell) const {
+    const glm::ivec2 d = cell - origins[level];
+    return d.x >= 0 && d.y >= 0 && d.x < n_ && d.y < n_;
+  }
+  void move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origins);
+  // A cell's ground, whether paved and its place along the track, from the surface (s_guess: a
+  // place along the track within a few metres).
+  void sample(int level, glm::ivec2 cell, std::size_t c, double s_guess);
+  // How deep water stands at a point before it spills out of the relief's hollows (m).
+  double held_at(double s, double lateral) const;
+  // The old windows' water over a level's cell that a finer ring held (m^3).
+  double old_volume(int level, glm::ivec2 cell) const;
+  // Shares volume_m3 out to cells of the new windows: the texture first, evenly, then a film of up
+  // to film_m evenly, then the hollows, deepest first, then the rest evenly.
+  void share_out(const std::vector<std::size_t>& cells, double volume_m3, double film_m);
+  // What a cell holds back from the flow over its texture (its hollows', if coarse).
+  double storage(std::size_t c) const { return c < layer() ? 0.0 : hollow_[c]; }
+  std::size_t layer() const { return static_cast<std::size_t>(n_) * n_; }
+  void to_record(int level, glm::ivec2 cell, double water, double hollow);
+  // Brings a record to now: its film runs off (film_runoff_s), then its water evaporates.
   void settle(Record& r);
-  int index(glm::dvec2 xy) const;  // -1 outside the window
+  void trim_records(glm::dvec2 centre);
+  int find(glm::dvec2 xy) const;  // the owned cell holding xy, -1 outside the windows
+  double area(int level) const { return cell_m(level) * cell_m(level); }
 
   const RoadSurface& surface_;
   RoadWaterConfig config_;
   int n_ = 0;
-  int record_cells_ = 8;  // per side
+  int levels_ = 1;
   bool placed_ = false;
-  glm::ivec2 origin_{0};
+  std::array<glm::ivec2, kRoadWaterMaxLevels> origins_{};
   double time_s_ = 0.0;
   double dry_time_s_ = 0.0;  // time stepped without rain: the records evaporate by it
   std::vector<double> ground_, water_;
-  std::vector<std::uint8_t> paved_;
-  std::vector<double> outflow_, flow_x_, flow_y_;   // one step's flows (m^3), made once
-  std::vector<double> spare_ground_, spare_water_;  // move_to's, made once
-  std::vector<std::uint8_t> spare_paved_;
-  std::map<Key, Record> records_;       // coarse, by record_m squares
-  std::map<Key, Record> puddle_cells_;  // by cell: a puddle's water (cells_out unused)
+  std::vector<std::uint8_t> paved_, owned_;
+  std::vector<double> track_s_;  // each cell's centre's place along the track (the next's guess)
+  // What the relief's hollows hold under a cell (m of depth, held_at): at a finest cell's centre;
+  // in a coarse cell, the mean over it, which it holds back from the flow (its ground is the
+  // section's: the water in its ruts and bowls does not run).
+  std::vector<double> hollow_;
+  std::vector<double> outflow_, flow_x_, flow_y_;  // one step's flows (m^3), made once
+  struct Crossing {
+    std::size_t fine = 0, coarse = 0;
+    double volume = 0.0;  // from fine to coarse (signed)
+  };
+  std::vector<Crossing> crossings_;  // the edges across the rings' borders
+  // move_to's, made once.
+  std::vector<double> old_ground_, old_water_, old_track_s_, old_hollow_;
+  std::vector<std::uint8_t> old_paved_, old_owned_;
+  std::array<glm::ivec2, kRoadWaterMaxLevels> old_origins_{};
+  std::map<Source, std::vector<std::size_t>> shares_;
+  std::map<Key, Record> records_;  // by coarsest cell
   Ledger ledger_;
 };
 

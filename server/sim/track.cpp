@@ -97,7 +97,11 @@ TrackFrame Track::at(double s_in) const {
 }
 
 double Track::surface_height(double s, double lateral) const {
-  return elevation(s) - section_.crown_slope * std::min(std::abs(lateral), paved_half_width());
+  return elevation(s) + section_height(lateral);
+}
+
+double Track::section_height(double lateral) const {
+  return -section_.crown_slope * std::min(std::abs(lateral), paved_half_width());
 }
 
 double Track::lane_centre(int lane) const { return -(lane + 0.5) * section_.lane_width_m; }

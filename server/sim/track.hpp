@@ -39,6 +39,8 @@ class Track {
   TrackFrame at(double s) const;
   // Road surface height at lateral offset (left positive) from the centreline: the crowned section.
   double surface_height(double s, double lateral) const;
+  // The crowned section's height at a lateral offset, relative to the centreline's.
+  double section_height(double lateral) const;
   // Lateral offset of the centre of lane i on the side of travel (0 = the inner lane next to the
   // centreline, growing outwards); negative = right of the centreline as driven forwards.
   double lane_centre(int lane) const;

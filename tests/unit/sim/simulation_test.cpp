@@ -95,7 +95,8 @@ TEST(SimulationTest, EachRoadStepPublishesANewImageOfTheRoadsWater) {
   const auto image = sim.state().road_water;
   ASSERT_NE(image, nullptr);
   EXPECT_EQ(image->cells, sim.road().cells());
-  EXPECT_EQ(image->origin, sim.road().origin());
+  EXPECT_EQ(image->levels, sim.road().levels());
+  EXPECT_EQ(image->origins[0], sim.road().origin(0));
   EXPECT_GT(image->mean_water_mm, 0.0f);
   // What is drawn while the next step runs: the image the last one left.
   EXPECT_EQ(sim.inputs_after(1.0 / 30.0).road_water, image);
