@@ -103,6 +103,7 @@ int main(int argc, char** argv) {
   bool wipe = false;
   double speed = -1.0;
   double road_film_mm = -1.0;
+  double dry_after_s = -1.0;
   bool puddles = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -117,6 +118,8 @@ int main(int argc, char** argv) {
       wipe = true;
     } else if (arg == "--road-water" && i + 1 < argc) {
       road_film_mm = std::atof(argv[++i]);
+    } else if (arg == "--dry-after" && i + 1 < argc) {
+      dry_after_s = std::atof(argv[++i]);
     } else if (arg == "--puddles") {
       puddles = true;
     } else if (arg == "--speed" && i + 1 < argc) {
@@ -131,7 +134,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr,
                  "usage: downpour-render-views OUT_DIR [scene] [t_s] [width height] [rain_mm_h]"
                  " [--windshield N] [--blades A B] [--dash] [--measure FRAMES] [--wipe]"
-                 " [--speed MPS]\n");
+                 " [--speed MPS] [--road-water FILM_MM [--puddles]] [--dry-after S]\n");
     return 2;
   }
   const std::string out = positional[0];
@@ -151,7 +154,17 @@ int main(int argc, char** argv) {
 
   if (wipe) return wipe_sequence(out, scenario.seed, update, t, width, height, dash);
   sim::Simulation simulation(scenario.seed, update);
-  simulation.advance(t);
+  if (dry_after_s >= 0.0 && dry_after_s < t && update.weather) {
+    // The rain stops after dry_after_s (the road's water runs off and dries for the rest).
+    simulation.advance(dry_after_s);
+    sim::Update dry;
+    dry.weather = *update.weather;
+    dry.weather->rain_rate_mm_h = 0.0;
+    simulation.apply(dry);
+    simulation.advance(t - dry_after_s);
+  } else {
+    simulation.advance(t);
+  }
   sim::SceneState scene = simulation.state();
   if (windshield_metaballs == 0) {
     scene.windshield = testing::golden_windshield(scene.glass);

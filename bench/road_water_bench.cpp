@@ -40,15 +40,16 @@ void picture(const sim::RoadWater& water, const sim::RoadSurface& surface,
       const sim::Track::Projection p = track.project_near(xy, s_guess);
       if (i == 0) s_guess = p.s;
       double rgb[3];
-      if (!surface.paved(p.lateral)) {
+      // (Paved as the cell holding it is: a coarse cell is road or not as its centre is.)
+      const int c = water.cell_at(xy);
+      if (c < 0 || !water.paved()[c]) {
         rgb[0] = 0.35, rgb[1] = 0.5, rgb[2] = 0.3;
       } else {
         const double relief = surface.relief(p.s, p.lateral);  // <= 0
         const double grey = 0.75 + std::max(relief, -0.03) * 12.0;
         rgb[0] = rgb[1] = rgb[2] = grey;
         const double w = water.water_m(xy);
-        const int c = water.cell_at(xy);
-        switch (c < 0 ? sim::RoadState::kDry : water.cell_state(static_cast<std::size_t>(c))) {
+        switch (water.cell_state(static_cast<std::size_t>(c))) {
           case sim::RoadState::kDry:
             break;
           case sim::RoadState::kWet:

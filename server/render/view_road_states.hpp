@@ -16,10 +16,11 @@ struct RoadStateFractions {
 };
 
 // Rays through a 64 x 36 grid over the image that meet the paved road within 300 m, each classed by
-// the water where it lands: the window's cell, or beyond the window its mean. The road is found
-// on the plane of the road under the car, corrected once by the track's height where the ray
-// lands (crests and dips ahead). What stands in front of the road (the hood, other vehicles) is
-// not tested, as the view wet fraction does not test the cabin. RAIN and WINDSHIELD see no road.
+// the water where it lands: the finest ring's cell that holds it, or beyond the rings their mean.
+// The road is found on the plane of the road under the car, corrected once by the track's height
+// where the ray lands (crests and dips ahead). A ray that meets a vehicle first (a box around its
+// body down to the road: the hood from the driver's seat, the ego car from outside, the traffic)
+// sees no road. RAIN and WINDSHIELD see no road.
 RoadStateFractions view_road_states(const sim::ViewSpec& spec, const sim::SceneState& scene);
 
 }  // namespace downpour::render

@@ -371,8 +371,10 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
     }
   }
   for (auto& [source, cells] : shares_) {
-    if (source.level >= 0) {
-      const glm::ivec2 d = source.cell - old_origins_[source.level];
+    const glm::ivec2 d =
+        source.level >= 0 ? source.cell - old_origins_[source.level] : glm::ivec2(0);
+    const bool from_cell = source.level >= 0 && old_paved_[flat(source.level, d.x, d.y)];
+    if (from_cell) {
       const std::size_t oc = flat(source.level, d.x, d.y);
       const double w = old_water_[oc];
       // Its film over its hollows spreads evenly, what they hold goes to the finer cells' hollows.
@@ -380,7 +382,8 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
                 std::max(w - config_.capacity_m - old_hollow_[oc], 0.0));
       continue;
     }
-    const auto found = records_.find(Key{source.cell.x, source.cell.y});
+    const auto found =
+        source.level < 0 ? records_.find(Key{source.cell.x, source.cell.y}) : records_.end();
     if (found != records_.end()) {
       settle(found->second);
       const Record& r = found->second;
@@ -389,8 +392,9 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
       records_.erase(found);
       continue;
     }
-    // Rain fell here before the windows came: as much as their cells hold, its film spread and the
-    // rest in its hollows (it enters the ledger as rain now).
+    // Rain fell here before the windows came (or on the paved part of a coarse cell whose centre
+    // lies off the road, which holds no water): as much as the rings' cells hold, its film spread
+    // and the rest in its hollows (it enters the ledger as rain now).
     if (fresh_m <= 0.0) continue;
     double paved_area = 0.0;
     for (const std::size_t c : cells)
