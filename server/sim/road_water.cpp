@@ -577,6 +577,8 @@ void RoadWater::image(RoadWaterImage& out) const {
   out.capacity_mm = config_.capacity_m * 1e3;
   out.water_standing_mm.assign(water_.size() * 2, 0.0f);
   out.max_standing_mm = 0.0f;
+  out.mean_water_mm = out.mean_standing_mm = 0.0f;
+  if (!placed_) return;  // before the first step: all dry
   double water_sum = 0.0, standing_sum = 0.0, paved_area = 0.0;
   auto put = [&](std::size_t c) {
     out.water_standing_mm[2 * c] = static_cast<float>(sheet_m(c) * 1e3);
@@ -588,7 +590,7 @@ void RoadWater::image(RoadWaterImage& out) const {
     for (int j = 0; j < n; ++j) {
       for (int i = 0; i < n; ++i) {
         const std::size_t c = flat(l, i, j);
-        if (owned_[c] || l == 0) {  // (before the first step none is owned: all dry)
+        if (owned_[c]) {
           put(c);
           out.max_standing_mm = std::max(out.max_standing_mm, out.water_standing_mm[2 * c + 1]);
           if (paved_[c]) {

@@ -124,6 +124,29 @@ TEST_F(RoadWaterTest, TheRecordsStayBoundedAndTheLedgerStillCloses) {
   EXPECT_NEAR(out, l.rain_in_m3, 1e-9 * l.rain_in_m3);
 }
 
+TEST_F(RoadWaterTest, JumpsAnywhereKeepEveryCubicMetre) {
+  // A simulator may place the car anywhere at any step: jumps of up to a kilometre, off the road
+  // too, back and forth, in rain and dry spells.
+  RoadWater water(surface);
+  std::uint64_t state = 12345;
+  auto next = [&]() {  // a small deterministic stream
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) / static_cast<double>(1ULL << 53);
+  };
+  double s = 0.0;
+  for (int k = 0; k < 400; ++k) {
+    s += (next() - 0.3) * (k % 7 == 0 ? 2000.0 : 8.0);
+    const double lateral = (next() - 0.5) * (k % 11 == 0 ? 80.0 : 10.0);
+    water.step(at(s, lateral), k % 50 < 35 ? 40.0 : 0.0, 0.5);
+  }
+  const RoadWater::Ledger& l = water.ledger();
+  const double out = water.stored_m3() + l.drained_m3 + l.evaporated_m3 + l.thrown_m3;
+  std::printf("in %.4f m^3, %zu records\n", l.rain_in_m3, water.records());
+  EXPECT_GT(l.rain_in_m3, 0.0);
+  EXPECT_NEAR(out, l.rain_in_m3, 1e-9 * l.rain_in_m3);
+  for (const double w : water.water()) EXPECT_GE(w, 0.0);
+}
+
 TEST_F(RoadWaterTest, PuddlesFormInRutsBowlsAndAtTheEdgeNeverOnTheCrown) {
   RoadWater water(surface);
   const glm::dvec2 car = at(150.0, 0.0);  // on the first straight
@@ -352,6 +375,11 @@ TEST_F(RoadWaterTest, TheSameInputsGiveTheSameWater) {
 
 TEST_F(RoadWaterTest, TheImageForTheRendererIsTheRingsInMillimetres) {
   RoadWater water(surface);
+  RoadWaterImage before;  // before the first step: the rings' size, all dry
+  water.image(before);
+  ASSERT_TRUE(before.complete());
+  EXPECT_EQ(*std::max_element(before.water_standing_mm.begin(), before.water_standing_mm.end()),
+            0.0f);
   for (int k = 0; k < 600; ++k) water.step(at(250.0, -1.75), 30.0, 0.1);  // a minute of 30 mm/h
   RoadWaterImage image;
   water.image(image);
