@@ -90,7 +90,7 @@ void RoadWater::sample(int level, glm::ivec2 cell, std::size_t c, double s_guess
       surface_.paved(p.lateral + 0.5 * size)) {
     for (int k = 0; k < points; ++k) {
       const double u = ((k + 0.5) / points - 0.5) * size;
-      sum += held_at(p.s, p.lateral + u * glm::length(left));
+      sum += held_at(p.s, p.lateral + u);
     }
   }
   hollow_[c] = sum / points;
@@ -116,10 +116,38 @@ double RoadWater::held_at(double s, double lateral) const {
   return std::max(spill - here, 0.0);
 }
 
+void RoadWater::sample_window(int level) {
+  // Every cell from the surface, from the middle out, each from its neighbour's place along the
+  // track, the middle one's from a search of the whole track.
+  const int n = n_, m = n / 2;
+  const glm::dvec2 middle = (glm::dvec2(origins_[level] + glm::ivec2(m)) + 0.5) * cell_m(level);
+  auto at = [&](int i, int j, double guess) {
+    sample(level, origins_[level] + glm::ivec2(i, j), flat(level, i, j), guess);
+  };
+  at(m, m, surface_.track().project(middle, 40.0).s);
+  for (int i = m + 1; i < n; ++i) at(i, m, track_s_[flat(level, i - 1, m)]);
+  for (int i = m - 1; i >= 0; --i) at(i, m, track_s_[flat(level, i + 1, m)]);
+  for (int j = m + 1; j < n; ++j)
+    for (int i = 0; i < n; ++i) at(i, j, track_s_[flat(level, i, j - 1)]);
+  for (int j = m - 1; j >= 0; --j)
+    for (int i = 0; i < n; ++i) at(i, j, track_s_[flat(level, i, j + 1)]);
+}
+
 void RoadWater::settle(Record& r) {
-  const double left = r.film_m3 * std::exp(-(time_s_ - r.time_s) / config_.film_runoff_s);
-  ledger_.drained_m3 += r.film_m3 - left;
+  // The rain that fell on it while it was away fills its texture, the rest runs off as a film: over
+  // T, under an even inflow R, a film f runs down to f e^(-T/tau) + R tau (1 - e^(-T/tau)).
+  const double rain = (rain_m_ - r.rain_m) * r.paved_m2;
+  const double into = std::clamp(config_.capacity_m * r.paved_m2 - r.texture_m3, 0.0, rain);
+  r.texture_m3 += into;
+  ledger_.rain_in_m3 += rain;
+  const double span = time_s_ - r.time_s, tau = config_.film_runoff_s;
+  const double keep = std::exp(-span / tau);
+  const double inflow = rain - into;
+  const double left =
+      r.film_m3 * keep + (span > 1e-9 ? inflow * tau / span * (1.0 - keep) : inflow);
+  ledger_.drained_m3 += r.film_m3 + inflow - left;
   r.film_m3 = left;
+  r.rain_m = rain_m_;
   const double held = r.texture_m3 + r.pooled_m3;
   const double gone =
       std::min(held, config_.evaporation_m_per_s * (dry_time_s_ - r.dry_time_s) * r.paved_m2);
@@ -132,12 +160,18 @@ void RoadWater::settle(Record& r) {
   r.time_s = time_s_;
 }
 
-void RoadWater::to_record(int level, glm::ivec2 cell, double water, double hollow) {
+void RoadWater::to_record(int level, glm::ivec2 cell, double water, double hollow, bool paved) {
+  if (!paved) {
+    ledger_.drained_m3 += water * area(level);  // (none stands off the road; a guard)
+    return;
+  }
+  // A paved cell leaves a record even dry: it stays dry, where road never seen takes the mean.
   const glm::ivec2 q = coarser(cell, levels_ - 1 - level);
   auto found = records_.find(Key{q.x, q.y});
   if (found == records_.end()) {
-    if (water <= 0.0) return;  // a dry cell leaves nothing to keep
-    found = records_.emplace(Key{q.x, q.y}, Record{0.0, 0.0, 0.0, 0.0, dry_time_s_, time_s_}).first;
+    found =
+        records_.emplace(Key{q.x, q.y}, Record{0.0, 0.0, 0.0, 0.0, dry_time_s_, time_s_, rain_m_})
+            .first;
   }
   Record& r = found->second;
   settle(r);
@@ -150,7 +184,7 @@ void RoadWater::to_record(int level, glm::ivec2 cell, double water, double hollo
   r.texture_m3 += std::min(water, config_.capacity_m) * a;
   r.pooled_m3 += held * a;
   r.film_m3 += (standing - held) * a;
-  r.paved_m2 += a;  // (water stands only on paved cells)
+  r.paved_m2 += a;
 }
 
 double RoadWater::old_volume(int level, glm::ivec2 cell) const {
@@ -232,23 +266,9 @@ void RoadWater::trim_records(glm::dvec2 centre) {
 void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origins) {
   const int n = n_;
   if (!placed_) {
-    // Every cell from the surface, from the middle out, each from its neighbour's place along the
-    // track.
     origins_ = origins;
-    const glm::dvec2 centre = (glm::dvec2(origins[0]) + 0.5 * n) * cell_m(0);
-    const double s_centre = surface_.track().project(centre, 40.0).s;
     for (int l = 0; l < levels_; ++l) {
-      auto at = [&](int i, int j, double guess) {
-        sample(l, origins[l] + glm::ivec2(i, j), flat(l, i, j), guess);
-      };
-      const int m = n / 2;
-      at(m, m, s_centre);
-      for (int i = m + 1; i < n; ++i) at(i, m, track_s_[flat(l, i - 1, m)]);
-      for (int i = m - 1; i >= 0; --i) at(i, m, track_s_[flat(l, i + 1, m)]);
-      for (int j = m + 1; j < n; ++j)
-        for (int i = 0; i < n; ++i) at(i, j, track_s_[flat(l, i, j - 1)]);
-      for (int j = m - 1; j >= 0; --j)
-        for (int i = 0; i < n; ++i) at(i, j, track_s_[flat(l, i, j + 1)]);
+      sample_window(l);
       for (int j = 0; j < n; ++j) {
         for (int i = 0; i < n; ++i) {
           const glm::ivec2 q = origins[l] + glm::ivec2(i, j);
@@ -302,10 +322,17 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
   // the surface (the guess from the nearest old cell); which of them hold their place's water.
   for (int l = 0; l < levels_; ++l) {
     if (!moved[l]) continue;
+    // A window that jumped (a simulator may place the car anywhere) has no old cell near its new
+    // ones to start from: all of it from the surface.
+    const glm::ivec2 shift = glm::abs(origins[l] - old_origins_[l]);
+    const bool jumped = std::max(shift.x, shift.y) > n / 4;
+    if (jumped) sample_window(l);
     for (int j = 0; j < n; ++j) {
       for (int i = 0; i < n; ++i) {
         const glm::ivec2 q = origins[l] + glm::ivec2(i, j);
         const std::size_t c = flat(l, i, j);
+        owned_[c] = l == 0 || !inside(origins, l - 1, 2 * q);
+        if (jumped) continue;
         const glm::ivec2 d = q - old_origins_[l];
         const glm::ivec2 near = glm::clamp(d, glm::ivec2(0), glm::ivec2(n - 1));
         const std::size_t oc = flat(l, near.x, near.y);
@@ -315,7 +342,6 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
         } else {
           sample(l, q, c, old_track_s_[oc]);
         }
-        owned_[c] = l == 0 || !inside(origins, l - 1, 2 * q);
       }
     }
   }
@@ -328,7 +354,7 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
         const std::size_t oc = flat(l, i, j);
         const glm::ivec2 q = old_origins_[l] + glm::ivec2(i, j);
         if (old_owned_[oc] && !inside(origins, levels_ - 1, coarser(q, levels_ - 1 - l)))
-          to_record(l, q, old_water_[oc], old_hollow_[oc]);
+          to_record(l, q, old_water_[oc], old_hollow_[oc], old_paved_[oc]);
       }
     }
   }
@@ -419,6 +445,7 @@ void RoadWater::step(glm::dvec2 centre, double rain_mm_h, double dt_s) {
   const bool raining = rain_mm_h > 0.0;
   time_s_ += dt_s;
   if (!raining) dry_time_s_ += dt_s;
+  if (raining) rain_m_ += rain_mm_h / 3.6e6 * dt_s;
 
   // Rain in, or evaporation out (the air is saturated while it rains), on the cells that hold
   // their place's water.

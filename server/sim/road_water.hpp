@@ -82,9 +82,10 @@ struct RoadWaterConfig {
   // Out of the windows a film keeps running off the road: the time constant of what is left (a
   // film crosses a half-width of 8 m at about 0.1 m/s). A puddle's water stays.
   double film_runoff_s = 60.0;
-  // The records kept out of the windows (one per coarsest cell the road's water left): past this
-  // many, the farther half is let go (counted as drained: 2 m cells, 100 km of a 16 m road).
-  std::size_t max_records = 400000;
+  // The records kept out of the windows (one per coarsest cell of road that left them, about 100
+  // bytes each): past this many, the farther half is let go (counted as drained: 2 m cells, 25 km
+  // of a 16 m road).
+  std::size_t max_records = 100000;
 };
 
 // The state of a cell holding water_m (all of it, m) under these thresholds.
@@ -113,6 +114,9 @@ class RoadWater {
   double take(glm::dvec2 xy, double volume_m3);
 
   struct Ledger {
+    // The rain on the windows' road and on the records', and the water of road the windows take in
+    // without a record of it (never seen, or under a coarse cell whose centre lies off the road):
+    // as much as the rings hold on average.
     double rain_in_m3 = 0.0;
     double drained_m3 = 0.0;     // off the paved edge (and records let go)
     double evaporated_m3 = 0.0;  // in the windows and in the records
@@ -159,6 +163,7 @@ class RoadWater {
     double paved_m2 = 0.0;    // the paved area it came from (evaporation's)
     double dry_time_s = 0.0;  // dry_time_s_ when it was last settled
     double time_s = 0.0;      // time_s_ then
+    double rain_m = 0.0;      // rain_m_ then
   };
   using Key = std::pair<int, int>;
   // Where the water of a place came from, for the cells that share it out when a window moves.
@@ -179,6 +184,8 @@ class RoadWater {
     return d.x >= 0 && d.y >= 0 && d.x < n_ && d.y < n_;
   }
   void move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origins);
+  // A level's whole window from the surface.
+  void sample_window(int level);
   // A cell's ground, whether paved and its place along the track, from the surface (s_guess: a
   // place along the track within a few metres).
   void sample(int level, glm::ivec2 cell, std::size_t c, double s_guess);
@@ -192,8 +199,9 @@ class RoadWater {
   // What a cell holds back from the flow over its texture (its hollows', if coarse).
   double storage(std::size_t c) const { return c < layer() ? 0.0 : hollow_[c]; }
   std::size_t layer() const { return static_cast<std::size_t>(n_) * n_; }
-  void to_record(int level, glm::ivec2 cell, double water, double hollow);
-  // Brings a record to now: its film runs off (film_runoff_s), then its water evaporates.
+  void to_record(int level, glm::ivec2 cell, double water, double hollow, bool paved);
+  // Brings a record to now: the rain since fills its texture, its film runs off (film_runoff_s),
+  // then its water evaporates.
   void settle(Record& r);
   void trim_records(glm::dvec2 centre);
   int find(glm::dvec2 xy) const;  // the owned cell holding xy, -1 outside the windows
@@ -207,6 +215,7 @@ class RoadWater {
   std::array<glm::ivec2, kRoadWaterMaxLevels> origins_{};
   double time_s_ = 0.0;
   double dry_time_s_ = 0.0;  // time stepped without rain: the records evaporate by it
+  double rain_m_ = 0.0;      // the rain that has fallen (m): the records take theirs by it
   std::vector<double> ground_, water_;
   std::vector<std::uint8_t> paved_, owned_;
   std::vector<double> track_s_;  // each cell's centre's place along the track (the next's guess)

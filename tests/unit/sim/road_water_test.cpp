@@ -275,6 +275,33 @@ TEST_F(RoadWaterTest, WaterStaysWhereItFellWhenTheCarDrivesAwayAndBack) {
   EXPECT_GT(in_rings(trip), 0.7 * in_rings(wait));
 }
 
+TEST_F(RoadWaterTest, TheRainFallsOnTheRoadTheCarLeftBehind) {
+  // A minute of rain, then one car goes 600 m away for two minutes of rain and comes back while
+  // another waits: the road the first one left took the rain as the waiting car's did.
+  RoadWater trip(surface), wait(surface);
+  const double s0 = 150.0;
+  for (RoadWater* water : {&trip, &wait}) {
+    for (int k = 0; k < 600; ++k) water->step(at(s0, 0.0), 30.0, 0.1);
+  }
+  for (int k = 0; k < 1200; ++k) {
+    const double s = k < 30 ? s0 + 20.0 * k : k >= 1170 ? s0 + 20.0 * (1200 - k) : s0 + 600.0;
+    trip.step(at(s, 0.0), 30.0, 0.1);
+    wait.step(at(s0, 0.0), 30.0, 0.1);
+  }
+  for (RoadWater* water : {&trip, &wait}) {
+    for (int k = 0; k < 300; ++k) water->step(at(s0, 0.0), 30.0, 0.1);
+  }
+  const std::set<Cell> came_back = puddles(trip, 1), waited = puddles(wait, 1);
+  int both = 0;
+  for (const auto& cell : came_back) both += waited.count(cell);
+  std::printf(
+      "water in the rings %.4f against %.4f m^3; puddle cells %zu against %zu, %d in both\n",
+      in_rings(trip), in_rings(wait), came_back.size(), waited.size(), both);
+  EXPECT_NEAR(in_rings(trip), in_rings(wait), 0.1 * in_rings(wait));
+  ASSERT_FALSE(waited.empty());
+  EXPECT_GT(both, static_cast<int>(waited.size()) * 7 / 10);
+}
+
 TEST_F(RoadWaterTest, PuddlesAreThereAheadOfACarAt30MetresASecond) {
   // After 5 minutes of rain a car sets off at 30 m/s; another stands further on all along. As the
   // first one arrives, its finest ring holds water where the other's has its puddles: the coarse
