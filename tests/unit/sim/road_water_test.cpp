@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <set>
 #include <tuple>
 #include <utility>
@@ -62,6 +63,18 @@ class RoadWaterTest : public ::testing::Test {
       lowest = std::min(lowest, surface.relief(q.s, q.lateral));
     }
     return lowest < -0.001 || std::abs(p.lateral) > track.paved_half_width() - 1.0;
+  }
+  // Steps each of the models standing at xy.
+  static void stand(std::initializer_list<RoadWater*> waters, glm::dvec2 xy, double rain_mm_h,
+                    int steps, double dt_s) {
+    for (RoadWater* water : waters)
+      for (int k = 0; k < steps; ++k) water->step(xy, rain_mm_h, dt_s);
+  }
+  // How many cells two sets share.
+  static int common(const std::set<Cell>& a, const std::set<Cell>& b) {
+    int n = 0;
+    for (const Cell& cell : a) n += static_cast<int>(b.count(cell));
+    return n;
   }
   // The water the rings hold (m^3).
   static double in_rings(const RoadWater& water) {
@@ -249,20 +262,14 @@ TEST_F(RoadWaterTest, WaterStaysWhereItFellWhenTheCarDrivesAwayAndBack) {
   // waits.
   RoadWater trip(surface), wait(surface);
   const double s0 = 150.0;
-  for (RoadWater* water : {&trip, &wait}) {
-    for (int k = 0; k < 1800; ++k) water->step(at(s0, 0.0), 30.0, 0.1);  // 3 minutes
-  }
+  stand({&trip, &wait}, at(s0, 0.0), 30.0, 1800, 0.1);  // 3 minutes
   const std::set<Cell> when_left = puddles(trip, 1);
   for (int k = 1; k <= 40; ++k) trip.step(at(s0 + 10.0 * k, 0.0), 0.0, 0.25);
   for (int k = 39; k >= 0; --k) trip.step(at(s0 + 10.0 * k, 0.0), 0.0, 0.25);
   for (int k = 0; k < 40; ++k) wait.step(at(s0, 0.0), 0.0, 0.5);
-  // Then both settle for a minute.
-  for (RoadWater* water : {&trip, &wait}) {
-    for (int k = 0; k < 600; ++k) water->step(at(s0, 0.0), 0.0, 0.1);
-  }
+  stand({&trip, &wait}, at(s0, 0.0), 0.0, 600, 0.1);  // then both settle for a minute
   const std::set<Cell> after_trip = puddles(trip, 1), after_wait = puddles(wait, 1);
-  int both = 0;
-  for (const auto& cell : after_trip) both += after_wait.count(cell);
+  const int both = common(after_trip, after_wait);
   std::printf(
       "puddle cells of the finest ring: %zu when the car left; a minute after it came back %zu, "
       "%zu for the car that waited, %d in both; water in the rings %.4f against %.4f m^3\n",
@@ -280,20 +287,15 @@ TEST_F(RoadWaterTest, TheRainFallsOnTheRoadTheCarLeftBehind) {
   // another waits: the road the first one left took the rain as the waiting car's did.
   RoadWater trip(surface), wait(surface);
   const double s0 = 150.0;
-  for (RoadWater* water : {&trip, &wait}) {
-    for (int k = 0; k < 600; ++k) water->step(at(s0, 0.0), 30.0, 0.1);
-  }
+  stand({&trip, &wait}, at(s0, 0.0), 30.0, 600, 0.1);
   for (int k = 0; k < 1200; ++k) {
     const double s = k < 30 ? s0 + 20.0 * k : k >= 1170 ? s0 + 20.0 * (1200 - k) : s0 + 600.0;
     trip.step(at(s, 0.0), 30.0, 0.1);
     wait.step(at(s0, 0.0), 30.0, 0.1);
   }
-  for (RoadWater* water : {&trip, &wait}) {
-    for (int k = 0; k < 300; ++k) water->step(at(s0, 0.0), 30.0, 0.1);
-  }
+  stand({&trip, &wait}, at(s0, 0.0), 30.0, 300, 0.1);
   const std::set<Cell> came_back = puddles(trip, 1), waited = puddles(wait, 1);
-  int both = 0;
-  for (const auto& cell : came_back) both += waited.count(cell);
+  const int both = common(came_back, waited);
   std::printf(
       "water in the rings %.4f against %.4f m^3; puddle cells %zu against %zu, %d in both\n",
       in_rings(trip), in_rings(wait), came_back.size(), waited.size(), both);
