@@ -178,9 +178,7 @@ void RoadWater::to_record(int level, glm::ivec2 cell, double water, double hollo
   // The texture's water, what the hollows hold (a finest cell's if a puddle) and the film over it.
   const double a = area(level);
   const double standing = std::max(water - config_.capacity_m, 0.0);
-  const double held = level > 0                               ? std::min(standing, hollow)
-                      : state_of(water) == RoadState::kPuddle ? standing
-                                                              : 0.0;
+  const double held = held_m(water, hollow, level > 0);
   r.texture_m3 += std::min(water, config_.capacity_m) * a;
   r.pooled_m3 += held * a;
   r.film_m3 += (standing - held) * a;
@@ -309,10 +307,7 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
     const double a = area(static_cast<int>(c / layer()));
     sum += old_water_[c] * a;
     const double standing = std::max(old_water_[c] - config_.capacity_m, 0.0);
-    const double held = c >= layer() ? std::min(standing, old_hollow_[c])
-                        : state_of(old_water_[c]) == RoadState::kPuddle ? standing
-                                                                        : 0.0;
-    film_sum += (standing - held) * a;
+    film_sum += (standing - held_m(old_water_[c], old_hollow_[c], c >= layer())) * a;
     counted += a;
   }
   const double fresh_m = counted > 0.0 ? sum / counted : 0.0;
@@ -405,7 +400,7 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
       const double w = old_water_[oc];
       // Its film over its hollows spreads evenly, what they hold goes to the finer cells' hollows.
       share_out(cells, w * area(source.level),
-                std::max(w - config_.capacity_m - old_hollow_[oc], 0.0));
+                std::max(w - config_.capacity_m, 0.0) - held_m(w, old_hollow_[oc], true));
       continue;
     }
     const auto found =

@@ -141,15 +141,12 @@ class RoadWater {
   const std::vector<double>& water() const { return water_; }
   const std::vector<std::uint8_t>& paved() const { return paved_; }
   const std::vector<std::uint8_t>& owned() const { return owned_; }
-  const std::vector<double>& hollow() const { return hollow_; }  // (m, see hollow_)
   std::size_t records() const { return records_.size(); }
   RoadState state_of(double water_m) const { return road_state(water_m, config_); }
   // A cell's water as its state sees it (m): a coarse cell's without what its hollows hold (its
   // ruts full, the rest of it under a film is not a puddle), and its state.
   double sheet_m(std::size_t c) const {
-    return c < layer()
-               ? water_[c]
-               : water_[c] - std::min(std::max(water_[c] - config_.capacity_m, 0.0), hollow_[c]);
+    return c < layer() ? water_[c] : water_[c] - held_m(water_[c], hollow_[c], true);
   }
   RoadState cell_state(std::size_t c) const { return state_of(sheet_m(c)); }
   // The rings as the renderer draws them.
@@ -196,6 +193,14 @@ class RoadWater {
   // Shares volume_m3 out to cells of the new windows: the texture first, evenly, then a film of up
   // to film_m evenly, then the hollows, deepest first, then the rest evenly.
   void share_out(const std::vector<std::size_t>& cells, double volume_m3, double film_m);
+  // Of a cell's standing water, what stays where it is (m): in a coarse cell what its hollows
+  // hold, in a finest cell all of a puddle's (the rest is film, which runs).
+  double held_m(double water, double hollow, bool coarse) const {
+    const double standing = std::max(water - config_.capacity_m, 0.0);
+    return coarse                                  ? std::min(standing, hollow)
+           : state_of(water) == RoadState::kPuddle ? standing
+                                                   : 0.0;
+  }
   // What a cell holds back from the flow over its texture (its hollows', if coarse).
   double storage(std::size_t c) const { return c < layer() ? 0.0 : hollow_[c]; }
   std::size_t layer() const { return static_cast<std::size_t>(n_) * n_; }

@@ -205,6 +205,7 @@ TEST_F(RoadWaterTest, NoPuddleOnTheCrestsTopButInItsRutsAndBowls) {
       "crest's top at s = %.0f m: %zu puddle cells in the finest two rings, %d in the relief "
       "or at the edge\n",
       top, found.size(), in_relief);
+  EXPECT_FALSE(found.empty());  // (it rains there as elsewhere: the ruts fill)
   EXPECT_EQ(in_relief, static_cast<int>(found.size()));
 }
 
