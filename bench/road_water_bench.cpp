@@ -120,11 +120,11 @@ int main(int argc, char** argv) {
       puddle_cells += c < per_level && state == sim::RoadState::kPuddle;
     }
     const sim::RoadWater::Ledger& l = water.ledger();
-    const double closure =
-        l.rain_in_m3 > 0.0
-            ? (water.stored_m3() + l.drained_m3 + l.evaporated_m3 + l.thrown_m3 - l.rain_in_m3) /
-                  l.rain_in_m3
-            : 0.0;
+    const double closure = l.rain_in_m3 > 0.0
+                               ? (water.stored_m3() + l.drained_m3 + l.evaporated_m3 + l.thrown_m3 -
+                                  l.returned_m3 - l.rain_in_m3) /
+                                     l.rain_in_m3
+                               : 0.0;
     std::printf(
         "{\"at\": \"%s\", \"time_s\": %.0f, \"speed_mps\": %.0f, \"dry\": %.3f, \"wet\": %.3f, "
         "\"drench\": %.3f, \"puddle\": %.3f, \"puddle_cells\": %d, \"rain_in_m3\": %.4f, "

@@ -83,7 +83,6 @@ void RoadWater::sample(int level, glm::ivec2 cell, std::size_t c, double s_guess
   // A coarse cell: the section's height at its centre, and the mean of what the hollows hold
   // across it, at points 1/8 m apart across the road (a rut's water lies in a narrow band; along
   // the road, ruts change slowly).
-  const glm::dvec2 left = surface_.track().at(p.s).left;
   const int points = 4 << (level - 1);
   double sum = 0.0;
   if (paved_[c] || surface_.paved(p.lateral - 0.5 * size) ||
@@ -270,7 +269,12 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
       for (int j = 0; j < n; ++j) {
         for (int i = 0; i < n; ++i) {
           const glm::ivec2 q = origins[l] + glm::ivec2(i, j);
-          owned_[flat(l, i, j)] = l == 0 || !inside(origins, l - 1, 2 * q);
+          const std::size_t c = flat(l, i, j);
+          owned_[c] = l == 0 || !inside(origins, l - 1, 2 * q);
+          if (owned_[c] && paved_[c] && config_.initial_m > 0.0) {
+            water_[c] = config_.initial_m;
+            ledger_.rain_in_m3 += config_.initial_m * area(l);
+          }
         }
       }
     }
@@ -588,6 +592,14 @@ double RoadWater::take(glm::dvec2 xy, double volume_m3) {
   water_[c] -= taken / a;
   ledger_.thrown_m3 += taken;
   return taken;
+}
+
+double RoadWater::give(glm::dvec2 xy, double volume_m3) {
+  const int c = find(xy);
+  if (c < 0 || !paved_[c] || !(volume_m3 > 0.0)) return 0.0;
+  water_[c] += volume_m3 / area(c / (n_ * n_));
+  ledger_.returned_m3 += volume_m3;
+  return volume_m3;
 }
 
 void RoadWater::image(RoadWaterImage& out) const {

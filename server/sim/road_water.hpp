@@ -86,6 +86,9 @@ struct RoadWaterConfig {
   // bytes each): past this many, the farther half is let go (counted as drained: 2 m cells, 25 km
   // of a 16 m road).
   std::size_t max_records = 100000;
+  // The water on every paved cell when the windows are first placed (m; booked as rain in): 0, a
+  // dry road, by default; tools and tests start on a road that has been wet for a while.
+  double initial_m = 0.0;
 };
 
 // The state of a cell holding water_m (all of it, m) under these thresholds.
@@ -112,6 +115,9 @@ class RoadWater {
   int cell_at(glm::dvec2 xy) const { return find(xy); }
   // Takes up to volume_m3 from the cell at xy (spray); returns what it took.
   double take(glm::dvec2 xy, double volume_m3);
+  // Adds volume_m3 to the cell at xy (spray landing back); returns what it took (0 outside the
+  // windows or off the paved road).
+  double give(glm::dvec2 xy, double volume_m3);
 
   struct Ledger {
     // The rain on the windows' road and on the records', and the water of road the windows take in
@@ -121,10 +127,11 @@ class RoadWater {
     double drained_m3 = 0.0;     // off the paved edge (and records let go)
     double evaporated_m3 = 0.0;  // in the windows and in the records
     double thrown_m3 = 0.0;      // taken (spray)
+    double returned_m3 = 0.0;    // given back (spray that landed)
   };
   const Ledger& ledger() const { return ledger_; }
-  // Water held in the windows and in the records (m^3): rain in = stored + drained + evaporated +
-  // thrown.
+  // Water held in the windows and in the records (m^3): rain in + returned = stored + drained +
+  // evaporated + thrown.
   double stored_m3() const;
 
   const RoadWaterConfig& config() const { return config_; }

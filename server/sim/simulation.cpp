@@ -9,9 +9,24 @@
 #include "server/sim/pose.hpp"
 
 namespace downpour::sim {
+namespace {
+
+constexpr double kMaxExtrapolationS = 0.5;
+
+SimulationConfig with_spray_step(SimulationConfig config) {
+  config.spray.step_s = config.sub_steps_per_spray_step * config.sub_step_s;
+  return config;
+}
+
+glm::dvec3 wind_velocity(const Weather& w) {
+  const double dir = w.wind_direction_deg * M_PI / 180.0;
+  return {w.wind_speed_mps * std::cos(dir), w.wind_speed_mps * std::sin(dir), 0.0};
+}
+
+}  // namespace
 
 Simulation::Simulation(std::uint64_t seed, const Update& initial, SimulationConfig config)
-    : config_(config),
+    : config_(with_spray_step(config)),
       seed_(seed),
       wipers_(config.windshield.wipers),
       water_(config.windshield, seed),
@@ -19,7 +34,8 @@ Simulation::Simulation(std::uint64_t seed, const Update& initial, SimulationConf
       water_map_(config.windshield.glass, config.water_map),
       blades_at_water_step_(wipers_.poses()),
       surface_(std::make_shared<const RoadSurface>(Track::built_in(), seed)),
-      road_(*surface_, config.road) {
+      road_(*surface_, config.road),
+      spray_(seed, config_.spray) {
   state_.glass = config_.windshield.glass;
   apply(initial);
   publish();
@@ -39,6 +55,9 @@ void Simulation::publish() {
     state_.road_water = std::move(image);
     road_image_stale_ = false;
   }
+  auto spray = std::make_shared<SprayImage>();
+  spray_.image(state_.vehicle.position_m, *spray);
+  state_.spray = std::move(spray);
   // Under each tire: front left, front right, rear left, rear right.
   const glm::dmat4 to_world = vehicle_to_world(state_.vehicle);
   for (int t = 0; t < kTires; ++t) {
@@ -57,6 +76,7 @@ void Simulation::apply(const Update& update) {
   if (update.wipers) state_.wipers = *update.wipers;
   if (update.weather) state_.weather = *update.weather;
   if (update.traffic) state_.traffic = *update.traffic;
+  if (update.vehicle || update.traffic) input_time_s_ = state_.sim_time_s;
 }
 
 void Simulation::advance(double dt_s) {
@@ -64,6 +84,7 @@ void Simulation::advance(double dt_s) {
   const auto t0 = Clock::now();
   rain_ms_ = 0.0;
   road_ms_ = 0.0;
+  spray_ms_ = 0.0;
   carry_s_ += dt_s;
   while (whole_sub_step_due(carry_s_)) {
     sub_step();
@@ -74,8 +95,9 @@ void Simulation::advance(double dt_s) {
   publish();
   timing_.rain_ms = rain_ms_;
   timing_.road_ms = road_ms_;
-  timing_.water_ms =
-      std::chrono::duration<double, std::milli>(t1 - t0).count() - rain_step_ms - road_ms_;
+  timing_.spray_ms = spray_ms_;
+  timing_.water_ms = std::chrono::duration<double, std::milli>(t1 - t0).count() - rain_step_ms -
+                     road_ms_ - spray_ms_;
   timing_.publish_ms = std::chrono::duration<double, std::milli>(Clock::now() - t1).count() -
                        (rain_ms_ - rain_step_ms);
 }
@@ -104,11 +126,8 @@ SceneState Simulation::inputs_after(double dt_s) const {
 }
 
 glm::dvec3 Simulation::air_velocity_vehicle() const {
-  const Weather& w = state_.weather;
-  const double dir = w.wind_direction_deg * M_PI / 180.0;
-  const glm::dvec3 wind(w.wind_speed_mps * std::cos(dir), w.wind_speed_mps * std::sin(dir), 0.0);
   const glm::dmat3 to_world = rotation_matrix(state_.vehicle.rotation);
-  return glm::transpose(to_world) * (wind - state_.vehicle.velocity_mps);
+  return glm::transpose(to_world) * (wind_velocity(state_.weather) - state_.vehicle.velocity_mps);
 }
 
 void Simulation::sub_step() {
@@ -127,6 +146,13 @@ void Simulation::sub_step() {
     road_ms_ +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0).count();
   }
+  if (config_.simulate_spray && ++sub_steps_since_spray_ >= config_.sub_steps_per_spray_step) {
+    const auto s0 = std::chrono::steady_clock::now();
+    spray_step();
+    sub_steps_since_spray_ = 0;
+    spray_ms_ +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - s0).count();
+  }
   if (!config_.simulate_water ||
       ++sub_steps_since_water_ < config_.windshield.sub_steps_per_water_step) {
     return;
@@ -139,6 +165,34 @@ void Simulation::sub_step() {
   water_.step(sub_steps_since_water_ * config_.sub_step_s, in);
   blades_at_water_step_ = in.blades_after;
   sub_steps_since_water_ = 0;
+}
+
+// The ego car and the traffic, each moved on from its last input at its velocity, throw spray
+// from the road's water; what crosses the glass becomes drops there.
+void Simulation::spray_step() {
+  const double ahead = std::min(state_.sim_time_s - input_time_s_, kMaxExtrapolationS);
+  std::vector<SpraySource> sources;
+  sources.reserve(state_.traffic.size() + 1);
+  auto add = [&](std::uint32_t key, const VehicleState& state, glm::dvec3 size) {
+    SpraySource s{key, state, size};
+    s.state.position_m += state.velocity_mps * ahead;
+    sources.push_back(s);
+  };
+  add(0, state_.vehicle, glm::dvec3(4.5, 1.8, 1.47));
+  for (const TrafficVehicle& other : state_.traffic)
+    add(other.id == UINT32_MAX ? other.id : other.id + 1, other.state, other.size_m);
+  RoadWaterGround ground(road_);
+  if (state_.road_water) {
+    ground.set_mean(state_.road_water->mean_water_mm * 1e-3,
+                    state_.road_water->mean_standing_mm * 1e-3);
+  }
+  if (!config_.simulate_water) {
+    spray_.step(sources, wind_velocity(state_.weather), ground);
+    return;
+  }
+  spray_.step(
+      sources, wind_velocity(state_.weather), ground, &config_.windshield.glass,
+      [this](glm::dvec2 uv_mm, double mass_mg) { return water_.add_drop(uv_mm, mass_mg, true); });
 }
 
 }  // namespace downpour::sim

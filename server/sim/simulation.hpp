@@ -10,6 +10,7 @@
 #include "server/sim/glass_water_map.hpp"
 #include "server/sim/rain_field.hpp"
 #include "server/sim/road_water.hpp"
+#include "server/sim/spray.hpp"
 #include "server/sim/types.hpp"
 #include "server/sim/water.hpp"
 #include "server/sim/windshield.hpp"
@@ -24,6 +25,7 @@ struct AdvanceTiming {
   double publish_ms = 0.0;  // the metaballs and the glass water map
   double rain_ms = 0.0;     // the rain in the air: its steps and its copy for the renderer
   double road_ms = 0.0;     // the water on the road's steps
+  double spray_ms = 0.0;    // the spray's steps
 };
 
 struct SimulationConfig {
@@ -32,9 +34,12 @@ struct SimulationConfig {
   GlassWaterMapConfig water_map;
   RainFieldConfig rain;
   RoadWaterConfig road;
-  int sub_steps_per_road_step = 8;  // 1/30 s: the road's water changes over seconds
-  bool simulate_water = true;       // false: the glass stays dry (tools and tests of other effects)
-  bool simulate_road = true;        // false: the road stays dry
+  int sub_steps_per_road_step = 8;   // 1/30 s: the road's water changes over seconds
+  SprayConfig spray;                 // its step_s is set to sub_steps_per_spray_step sub-steps
+  int sub_steps_per_spray_step = 4;  // 1/60 s
+  bool simulate_water = true;  // false: the glass stays dry (tools and tests of other effects)
+  bool simulate_road = true;   // false: the road stays dry
+  bool simulate_spray = true;  // false: no spray
 };
 
 // What the renderer reads: a copy, taken on the render thread after a step.
@@ -53,6 +58,9 @@ struct SceneState {
   // The road's water around the car, for drawing; shared by copies, replaced after each road
   // step (null before the first).
   std::shared_ptr<const RoadWaterImage> road_water;
+  // The spray's parcels, relative to the ego car's reference point; replaced after each advance()
+  // (null before the first).
+  std::shared_ptr<const SprayImage> spray;
 };
 
 class Simulation {
@@ -71,12 +79,14 @@ class Simulation {
   const RainField& rain() const { return rain_; }
   const GlassWaterMapBuilder& water_map() const { return water_map_; }
   const RoadWater& road() const { return road_; }
+  const Spray& spray() const { return spray_; }
   const AdvanceTiming& last_advance_timing() const { return timing_; }
   // The relative air (wind minus the car's velocity) in the vehicle frame, m/s.
   glm::dvec3 air_velocity_vehicle() const;
 
  private:
   void sub_step();
+  void spray_step();
   void publish();
   bool whole_sub_step_due(double carry_s) const;
 
@@ -96,6 +106,13 @@ class Simulation {
   RoadWater road_;
   int sub_steps_since_road_ = 0;
   bool road_image_stale_ = true;  // a road step since state_.road_water was made
+  Spray spray_;
+  int sub_steps_since_spray_ = 0;
+  // The sim time of the last vehicle or traffic input: the spray's sources move on from there at
+  // their velocity (for at most kMaxExtrapolationS), so that tires throw along their path between
+  // inputs.
+  double input_time_s_ = 0.0;
+  double spray_ms_ = 0.0;
   AdvanceTiming timing_;
   double rain_ms_ = 0.0;  // the rain field's time in this advance, so far
   double road_ms_ = 0.0;  // the road water's, likewise

@@ -1,0 +1,340 @@
+#include "server/sim/spray.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+
+#include "server/sim/car_body.hpp"
+#include "server/sim/pose.hpp"
+#include "server/sim/road_water.hpp"
+
+namespace downpour::sim {
+namespace {
+
+constexpr double kGravity = 9.81;
+constexpr double kAirDensity = 1.2;       // kg/m^3
+constexpr double kAirViscosity = 1.8e-5;  // Pa s
+constexpr double kWaterDensity = 1000.0;
+constexpr double kDeg = M_PI / 180.0;
+// The renderer's car is the ego car's shape scaled to a traffic vehicle's size by these.
+constexpr double kCarLength = 4.6, kCarWidth = 1.8, kCarHeight = 1.47;
+
+}  // namespace
+
+SprayGround::Probe RoadWaterGround::probe(glm::dvec2 xy) const {
+  Probe p;
+  const int c = road_.cell_at(xy);
+  if (c < 0) {
+    p.beyond = true;
+    p.water_m = mean_water_m_;
+    p.standing_m = mean_standing_m_;
+    p.state = road_.state_of(mean_water_m_);
+    return p;
+  }
+  p.water_m = road_.water()[c];
+  p.standing_m = std::max(p.water_m - road_.config().capacity_m, 0.0);
+  p.state = road_.cell_state(static_cast<std::size_t>(c));
+  return p;
+}
+
+double RoadWaterGround::take(glm::dvec2 xy, double volume_m3) { return road_.take(xy, volume_m3); }
+
+double RoadWaterGround::give(glm::dvec2 xy, double volume_m3) { return road_.give(xy, volume_m3); }
+
+// A source as the step sees it: its frame, its speed and direction of travel, its size.
+struct Spray::Pose {
+  std::uint32_t key = 0;
+  glm::dvec3 position{0.0};
+  glm::dmat3 rotation{1.0};  // vehicle to world
+  glm::dvec3 velocity{0.0};
+  double speed = 0.0;            // horizontal
+  glm::dvec3 travel{1.0, 0, 0};  // horizontal unit, the direction of travel
+  glm::dvec3 left{0, 1.0, 0};    // horizontal unit, to its left
+  glm::dvec3 scale{1.0};         // of the car's shape to its size
+  double height = kCarHeight;
+  double rear_x = car_body::kHullRearX;
+  // The ground's height under a world point, on the plane of the vehicle's wheels.
+  double ground_z(glm::dvec3 p) const {
+    const glm::dvec3 n = rotation[2];
+    return position.z - (n.x * (p.x - position.x) + n.y * (p.y - position.y)) / n.z;
+  }
+};
+
+Spray::Spray(std::uint64_t seed, SprayConfig config) : config_(config), random_(seed, 5) {}
+
+double Spray::airborne_m3() const {
+  double sum = 0.0;
+  for (const SprayParticle& p : particles_) sum += p.volume_m3;
+  return sum;
+}
+
+glm::dvec3 Spray::wake(const Pose& v, glm::dvec3 p, double* strength) const {
+  *strength = 0.0;
+  if (v.speed < 0.1) return glm::dvec3(0.0);
+  const glm::dvec3 local = glm::transpose(v.rotation) * (p - v.position);
+  const double behind = v.rear_x - local.x;  // < 0 beside or under the vehicle
+  const double length = v.scale.x * kCarLength;
+  if (behind < -length) return glm::dvec3(0.0);
+  const double d = std::max(behind, 0.0);
+  const double half_width = 0.6 * v.scale.y * kCarWidth + 0.1 * d;
+  const double across = std::exp(-(local.y * local.y) / (half_width * half_width));
+  const double above = std::max(local.z - v.height, 0.0) / (0.5 * v.height);
+  const double up_to = std::exp(-above * above);
+  const double along = std::exp(-d / (config_.wake_heights * v.height));
+  *strength = along * across * up_to;
+  glm::dvec3 air = config_.wake_fraction * *strength * v.velocity;
+  if (behind > 0.0 && local.z < v.height) {
+    air += v.rotation[2] * (config_.upwash_fraction * v.speed * std::exp(-d / v.height) * across);
+  }
+  return air;
+}
+
+void Spray::emit(const Pose& v, SprayGround& ground) {
+  const SprayConfig& c = config_;
+  const double speed = v.speed;
+  if (speed < c.min_speed_mps) return;
+  const double dt = c.step_s;
+  const double thrown = speed * speed / (speed * speed + c.throw_speed_mps * c.throw_speed_mps);
+  const double radius = std::clamp(c.tire_radius_m * v.scale.z, 0.25, 0.6);
+  const double width = c.tire_width_m * std::clamp(v.scale.y, 0.8, 1.6);
+  const glm::dvec3 up = v.rotation[2];
+  const glm::dmat4 to_world = [&] {
+    glm::dmat4 m(v.rotation);
+    m[3] = glm::dvec4(v.position, 1.0);
+    return m;
+  }();
+  for (int t = 0; t < kTires; ++t) {
+    const double side = t % 2 == 0 ? 1.0 : -1.0;  // left tires throw to the left
+    const glm::dvec3 contact(to_world * glm::dvec4((t < 2 ? car_body::kWheelbase : 0.0) * v.scale.x,
+                                                   side * car_body::kTrackHalfWidth * v.scale.y,
+                                                   0.0, 1.0));
+    const SprayGround::Probe under = ground.probe(glm::dvec2(contact));
+    if (under.state == RoadState::kDry) continue;
+    const SprayKind kind = under.state == RoadState::kWet      ? SprayKind::kSmall
+                           : under.state == RoadState::kDrench ? SprayKind::kMedium
+                                                               : SprayKind::kLarge;
+    const double texture = under.water_m - under.standing_m;
+    // Flows (m^3/s): what the tread throws, and the sheet a tire in a puddle pushes aside.
+    const double tire_flow =
+        speed * width * (c.film_share * under.standing_m + c.texture_share * texture) * thrown;
+    const double splash_flow = under.state == RoadState::kPuddle
+                                   ? speed * width * under.standing_m * c.splash_share * thrown
+                                   : 0.0;
+    const double fill = 1.0 - std::exp(-tire_flow / c.flow_ref_m3_s);
+    const std::uint32_t n_tire = random_.poisson(c.tire_parcels_per_s * fill * dt);
+    const std::uint32_t n_mist = random_.poisson(c.mist_parcels_per_s * fill * dt);
+    const std::uint32_t n_splash = random_.poisson(
+        c.splash_parcels_per_s * (1.0 - std::exp(-splash_flow / c.flow_ref_m3_s)) * dt);
+    const std::size_t first = particles_.size();
+    double wanted = 0.0;
+    // On the arc behind the patch, leaving with the rim's velocity there (the wheel rolls: the
+    // rim at angle phi from straight down moves at speed (1 - cos phi) along and sin phi up).
+    auto from_tire = [&](SprayKind k, double volume, double slow) {
+      const double phi =
+          c.peak_deg * kDeg * -std::log(random_.uniform(1e-12, 1.0) * random_.uniform(1e-12, 1.0));
+      const double across = random_.uniform(-0.5, 0.5) * width;
+      const double keep = random_.uniform(0.75, 1.0) * slow;
+      const double out = random_.uniform(0.0, 0.2);
+      if (phi > c.mudguard_deg * kDeg) return;  // blocked: it stays on the road
+      SprayParticle p;
+      p.position_m = contact + up * radius +
+                     radius * (-std::sin(phi) * v.travel - std::cos(phi) * up) + v.left * across;
+      p.velocity_mps = speed * keep * ((1.0 - std::cos(phi)) * v.travel + std::sin(phi) * up) +
+                       v.left * (side * out * speed);
+      p.volume_m3 = volume;
+      p.source = v.key;
+      p.kind = k;
+      particles_.push_back(p);
+      wanted += volume;
+    };
+    for (std::uint32_t k = 0; k < n_tire; ++k)
+      from_tire(kind, (1.0 - c.mist_share) * tire_flow * dt / n_tire, 1.0);
+    for (std::uint32_t k = 0; k < n_mist; ++k)
+      from_tire(SprayKind::kMist, c.mist_share * tire_flow * dt / n_mist, 0.6);
+    // The splash: at theta from the direction of travel with density sin(2 theta), to both sides.
+    for (std::uint32_t k = 0; k < n_splash; ++k) {
+      const double theta = 0.5 * std::acos(1.0 - 2.0 * random_.uniform());
+      const double to = random_.uniform() < 0.5 ? -1.0 : 1.0;
+      const double rise = random_.uniform(10.0, 35.0) * kDeg;
+      const double depth = std::min(under.standing_m / 0.01, 1.0);
+      const double fast = speed * (0.3 + 0.5 * depth) * random_.uniform(0.7, 1.0);
+      const glm::dvec3 dir = std::cos(theta) * v.travel + std::sin(theta) * to * v.left;
+      SprayParticle p;
+      p.position_m = contact + v.travel * 0.12 + v.left * (to * 0.5 * width) + up * 0.02;
+      p.velocity_mps = fast * (std::cos(rise) * dir + std::sin(rise) * up);
+      p.volume_m3 = splash_flow * dt / n_splash;
+      p.source = v.key;
+      p.kind = SprayKind::kLarge;
+      p.splash = true;
+      particles_.push_back(p);
+      wanted += p.volume_m3;
+    }
+    if (wanted <= 0.0) continue;
+    // The water comes from the cell under the tire; a cell that holds less gives what it has.
+    const glm::dvec2 at(contact);
+    const double got = under.beyond ? wanted : ground.take(at, wanted);
+    (under.beyond ? ledger_.beyond_m3 : ledger_.taken_m3) += got;
+    const double share = got / wanted;
+    for (std::size_t i = first; i < particles_.size(); ++i) particles_[i].volume_m3 *= share;
+  }
+}
+
+void Spray::step(const std::vector<SpraySource>& sources, glm::dvec3 wind, SprayGround& ground,
+                 const GlassConfig* glass, const GlassHit& glass_hit) {
+  const SprayConfig& c = config_;
+  const double dt = c.step_s;
+  std::vector<Pose> poses;
+  poses.reserve(sources.size());
+  for (const SpraySource& s : sources) {
+    Pose p;
+    p.key = s.key;
+    p.position = s.state.position_m;
+    p.rotation = rotation_matrix(s.state.rotation);
+    p.velocity = s.state.velocity_mps;
+    const glm::dvec3 flat(p.velocity.x, p.velocity.y, 0.0);
+    p.speed = glm::length(flat);
+    const glm::dvec3 forward(p.rotation[0].x, p.rotation[0].y, 0.0);
+    p.travel = p.speed > 1e-6 ? flat / p.speed : glm::normalize(forward);
+    p.left = glm::dvec3(-p.travel.y, p.travel.x, 0.0);
+    const glm::dvec3 size = glm::max(s.size_m, glm::dvec3(0.5));
+    p.scale = size / glm::dvec3(kCarLength, kCarWidth, kCarHeight);
+    p.height = size.z;
+    p.rear_x = car_body::kHullRearX * p.scale.x;
+    poses.push_back(p);
+  }
+  std::vector<std::pair<std::uint32_t, std::size_t>> by_key;
+  for (std::size_t i = 0; i < poses.size(); ++i) by_key.emplace_back(poses[i].key, i);
+  std::sort(by_key.begin(), by_key.end());
+  auto pose_of = [&](std::uint32_t key) -> const Pose* {
+    const auto it =
+        std::lower_bound(by_key.begin(), by_key.end(), std::make_pair(key, std::size_t{0}));
+    return it != by_key.end() && it->first == key ? &poses[it->second] : nullptr;
+  };
+  const Pose* ego = glass && !poses.empty() ? &poses[0] : nullptr;
+  const glm::dmat3 ego_inverse = ego ? glm::transpose(ego->rotation) : glm::dmat3(1.0);
+  const glm::dvec3 ego_before = ego ? ego->position - ego->velocity * dt : glm::dvec3(0.0);
+  const glm::dvec3 glass_normal = glass ? glass->normal() : glm::dvec3(0.0);
+
+  // Drag toward the air (Schiller-Naumann), exact over the step for a constant rate.
+  std::array<double, kSprayKinds> stokes{};
+  for (int k = 0; k < kSprayKinds; ++k) {
+    const double d = c.diameter_mm[k] * 1e-3;
+    stokes[k] = 18.0 * kAirViscosity / (kWaterDensity * d * d);
+  }
+  const glm::dvec3 gravity(0.0, 0.0, -kGravity);
+  const double eddy_keep = std::exp(-dt / c.eddy_s);
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    SprayParticle p = particles_[i];
+    const int k = static_cast<int>(p.kind);
+    const Pose* from = pose_of(p.source);
+    glm::dvec3 air = wind;
+    double strength = 0.0;
+    if (from) air += wake(*from, p.position_m, &strength);
+    // The eddy: its variance relaxes to sigma^2 over the eddies' time (uniform kicks, variance
+    // 1/3 times 3).
+    const double sigma =
+        c.turbulence_mps + c.wake_turbulence * strength * (from ? from->speed : 0.0);
+    const double kick = sigma * std::sqrt(3.0 * (1.0 - eddy_keep * eddy_keep));
+    p.eddy_mps = glm::vec3(glm::dvec3(p.eddy_mps) * eddy_keep +
+                           kick * glm::dvec3(random_.uniform(-1.0, 1.0), random_.uniform(-1.0, 1.0),
+                                             random_.uniform(-1.0, 1.0)));
+    air += glm::dvec3(p.eddy_mps);
+    const double relative = glm::length(air - p.velocity_mps);
+    const double re = kAirDensity * relative * c.diameter_mm[k] * 1e-3 / kAirViscosity;
+    const double rate = stokes[k] * (1.0 + 0.15 * std::pow(re, 0.687));
+    const glm::dvec3 settled = air + gravity / rate;
+    const double decay = std::exp(-rate * dt);
+    const glm::dvec3 before = p.position_m;
+    p.position_m += settled * dt + (p.velocity_mps - settled) * ((1.0 - decay) / rate);
+    p.velocity_mps = settled + (p.velocity_mps - settled) * decay;
+    p.age_s += static_cast<float>(dt);
+
+    bool gone = false;
+    if (ego) {
+      // In the ego car's frame, which moved by its velocity over the step.
+      const glm::dvec3 q0 = ego_inverse * (before - ego_before);
+      const glm::dvec3 q1 = ego_inverse * (p.position_m - ego->position);
+      if (q1.x > -2.0 && q1.x < 6.0 && std::abs(q1.y) < 2.0 && q1.z < 3.0) {
+        const double s0 = glm::dot(q0 - glass->bottom_left_m, glass_normal);
+        const double s1 = glm::dot(q1 - glass->bottom_left_m, glass_normal);
+        if (s0 > 0.0 && s1 <= 0.0) {
+          const glm::dvec3 hit = q0 + (q1 - q0) * (s0 / (s0 - s1)) - glass->bottom_left_m;
+          const glm::dvec2 uv(glm::dot(hit, glass->u_axis()) * 1e3,
+                              glm::dot(hit, glass->v_axis()) * 1e3);
+          if (glass->contains(uv)) {
+            gone = true;
+            const double caught = p.volume_m3 * c.glass_capture[k];
+            ledger_.dispersed_m3 += p.volume_m3 - caught;
+            const double mg = caught * 1e9;
+            const int drops = std::clamp(static_cast<int>(std::ceil(mg / c.glass_drop_mg)), 1, 16);
+            const double spread_mm = radius_m(p) * 1e3 * 0.5;
+            for (int d = 0; d < drops; ++d) {
+              const glm::dvec2 at = uv + spread_mm * glm::dvec2(random_.uniform(-1.0, 1.0),
+                                                                random_.uniform(-1.0, 1.0));
+              const bool stayed = glass_hit && glass_hit(at, mg / drops);
+              (stayed ? ledger_.on_glass_m3 : ledger_.dispersed_m3) += caught / drops;
+            }
+          }
+        }
+        namespace body = car_body;
+        const bool in_hull = q1.x > body::kHullRearX && q1.x < body::kHullFrontX &&
+                             std::abs(q1.y) < body::kHullHalfWidth && q1.z > 0.2 &&
+                             q1.z < body::kHullTopZ;
+        // (The cabin's front is the glass, which leans back from kCabinFrontX.)
+        const bool in_cabin = q1.x > body::kCabinRearX && s1 <= 0.0 &&
+                              std::abs(q1.y) < body::kCabinHalfWidth && q1.z >= body::kHullTopZ &&
+                              q1.z < body::kRoofZ;
+        if (!gone && p.source != ego->key && (in_hull || in_cabin)) {
+          gone = true;
+          ledger_.on_body_m3 += p.volume_m3;
+        }
+      }
+    }
+    const Pose* plane = from ? from : (poses.empty() ? nullptr : &poses[0]);
+    if (!gone && plane && p.position_m.z < plane->ground_z(p.position_m)) {
+      gone = true;
+      const double back =
+          p.kind == SprayKind::kLarge ? ground.give(glm::dvec2(p.position_m), p.volume_m3) : 0.0;
+      ledger_.returned_m3 += back;
+      ledger_.landed_m3 += p.volume_m3 - back;
+    }
+    if (!gone && p.kind == SprayKind::kMist && p.age_s > c.mist_life_s) {
+      gone = true;
+      ledger_.dispersed_m3 += p.volume_m3;
+    }
+    if (!gone &&
+        (p.age_s > c.max_life_s ||
+         (!poses.empty() && glm::length(p.position_m - poses[0].position) > c.max_range_m))) {
+      gone = true;
+      ledger_.dropped_m3 += p.volume_m3;
+    }
+    if (!gone) particles_[kept++] = p;
+  }
+  particles_.resize(kept);
+
+  for (const Pose& v : poses) emit(v, ground);
+  // Over the budget, the oldest go first (they are at the front).
+  if (particles_.size() > c.max_particles) {
+    const std::size_t excess = particles_.size() - c.max_particles;
+    for (std::size_t i = 0; i < excess; ++i) ledger_.dropped_m3 += particles_[i].volume_m3;
+    particles_.erase(particles_.begin(), particles_.begin() + static_cast<std::ptrdiff_t>(excess));
+  }
+}
+
+void Spray::image(glm::dvec3 origin, SprayImage& out) const {
+  out.origin_m = origin;
+  out.points.clear();
+  out.points.reserve(particles_.size());
+  out.counts = {};
+  for (const SprayParticle& p : particles_) {
+    const glm::dvec3 r = p.position_m - origin;
+    out.points.push_back({static_cast<float>(r.x), static_cast<float>(r.y), static_cast<float>(r.z),
+                          static_cast<float>(radius_m(p)), p.kind, p.splash});
+    ++out.counts[static_cast<int>(p.kind)];
+  }
+}
+
+}  // namespace downpour::sim
