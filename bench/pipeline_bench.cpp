@@ -77,7 +77,8 @@ constexpr Ceiling kCeilings[] = {
     {"rain_layer", -1.0, "rain: the CPU layer alone (part of rain)"},
     {"road_reflection", -1.0, "wet road: the scene mirrored in the road (part of wet_road)"},
     {"wet_road", 4.0, "wet road, puddles, reflections: its share of the COCKPIT frame"},
-    {"spray", 6.0, "tyre spray (to come)"},
+    {"spray", 6.0, "tire spray: its layer (the spray at its budget: downpour-spray-bench)"},
+    {"spray_composite", -1.0, "tire spray: its layer over the view (part of spray)"},
     {"relief_shadows", 1.5, "relief shadows (to come)"},
     {"lights", 3.0, "lights (to come)"},
 };

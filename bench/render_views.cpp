@@ -6,6 +6,10 @@
 // --speed MPS: the car's speed along its heading (0: standing), in place of the scene's.
 // --road-water FILM_MM: a hand-made road (tests/render/road_water_fixture.hpp): a film of FILM_MM
 //   over the paved width (0: dry), and with --puddles the render tests' puddles ahead of the car.
+// --spray-drive GAP_M ROAD_MM SECONDS: in place of the scene's drive, a drive along the track
+//   (tests/support/spray_drive.hpp) at --speed (25 m/s if not given) for SECONDS behind a truck
+//   GAP_M ahead (0: alone), on a road that starts with ROAD_MM of water everywhere, in the scene's
+//   rain (or rain_mm_h).
 // --windshield N: a hand-made rainy windshield (tests/render/windshield_fixture.hpp) of about N
 //   metaballs instead of the simulation's, with the wiper blades at A and B degrees from +u
 //   (--blades; default 40 36); N = 0: the render tests' golden windshield. --dash: also the COCKPIT
@@ -23,6 +27,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +42,7 @@
 #include "tests/render/road_water_fixture.hpp"
 #include "tests/render/windshield_fixture.hpp"
 #include "tests/support/png_io.hpp"
+#include "tests/support/spray_drive.hpp"
 
 namespace {
 
@@ -105,6 +111,7 @@ int main(int argc, char** argv) {
   double road_film_mm = -1.0;
   double dry_after_s = -1.0;
   bool puddles = false;
+  std::optional<testing::SprayDrive> spray_drive;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--windshield" && i + 1 < argc) {
@@ -120,6 +127,13 @@ int main(int argc, char** argv) {
       road_film_mm = std::atof(argv[++i]);
     } else if (arg == "--dry-after" && i + 1 < argc) {
       dry_after_s = std::atof(argv[++i]);
+    } else if (arg == "--spray-drive" && i + 3 < argc) {
+      spray_drive.emplace();
+      const double gap = std::atof(argv[i + 1]);
+      if (gap > 0.0) spray_drive->truck_gap_m = gap;
+      spray_drive->road_water_m = std::atof(argv[i + 2]) * 1e-3;
+      spray_drive->seconds = std::atof(argv[i + 3]);
+      i += 3;
     } else if (arg == "--puddles") {
       puddles = true;
     } else if (arg == "--speed" && i + 1 < argc) {
@@ -134,7 +148,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr,
                  "usage: downpour-render-views OUT_DIR [scene] [t_s] [width height] [rain_mm_h]"
                  " [--windshield N] [--blades A B] [--dash] [--measure FRAMES] [--wipe]"
-                 " [--speed MPS] [--road-water FILM_MM [--puddles]] [--dry-after S]\n");
+                 " [--speed MPS] [--road-water FILM_MM [--puddles]] [--dry-after S]"
+                 " [--spray-drive GAP_M ROAD_MM SECONDS]\n");
     return 2;
   }
   const std::string out = positional[0];
@@ -153,8 +168,17 @@ int main(int argc, char** argv) {
   }
 
   if (wipe) return wipe_sequence(out, scenario.seed, update, t, width, height, dash);
-  sim::Simulation simulation(scenario.seed, update);
-  if (dry_after_s >= 0.0 && dry_after_s < t && update.weather) {
+  if (spray_drive) {
+    if (speed >= 0.0) spray_drive->speed_mps = speed;
+    if (update.weather) spray_drive->rain_mm_h = update.weather->rain_rate_mm_h;
+    spray_drive->seed = scenario.seed;
+  }
+  sim::Simulation simulation =
+      spray_drive ? testing::drive(*spray_drive) : sim::Simulation(scenario.seed, update);
+  if (spray_drive) {
+    std::printf("spray: %zu parcels, %.2f ml on the glass\n", simulation.spray().particles().size(),
+                simulation.spray().ledger().on_glass_m3 * 1e6);
+  } else if (dry_after_s >= 0.0 && dry_after_s < t && update.weather) {
     // The rain stops after dry_after_s (the road's water runs off and dries for the rest).
     simulation.advance(dry_after_s);
     sim::Update dry;

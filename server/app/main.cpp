@@ -84,6 +84,7 @@ int main(int argc, char** argv) {
   registry.set_idle_timeout_s(config->session_idle_timeout_s);
   session::SchedulerOptions options;
   options.renderer.platform = config->renderer;
+  options.renderer.spray_smoothing = config->spray_smoothing;
   options.encoder_threads = config->encoder_threads;
   session::FrameScheduler scheduler(registry, options);
   try {

@@ -114,6 +114,15 @@ std::optional<ServerConfig> parse_config(int argc, char** argv, int* exit_code) 
   app.add_option("--renderer", c.renderer, "auto: a GPU's EGL device if any, else Mesa surfaceless")
       ->transform(CLI::CheckedTransformer(renderers, CLI::ignore_case))
       ->envname("DOWNPOUR_RENDERER");
+  const std::map<std::string, render::SpraySmoothing> smoothings{
+      {"plane_fit", render::SpraySmoothing::kPlaneFit},
+      {"bilateral", render::SpraySmoothing::kBilateral},
+      {"none", render::SpraySmoothing::kNone}};
+  app.add_option("--spray-smoothing", c.spray_smoothing,
+                 "the spray's liquid surface (seed 001): plane_fit (9x9, 3 passes), bilateral "
+                 "(7x7, 22 passes) or none")
+      ->transform(CLI::CheckedTransformer(smoothings, CLI::ignore_case))
+      ->envname("DOWNPOUR_SPRAY_SMOOTHING");
   app.add_option("--log-level", c.log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->envname("DOWNPOUR_LOG_LEVEL");

@@ -9,6 +9,7 @@
 #include <grpcpp/security/server_credentials.h>
 
 #include "server/render/egl_context.hpp"
+#include "server/render/spray_smoothing.hpp"
 #include "server/session/admission.hpp"
 
 namespace downpour::app {
@@ -23,6 +24,7 @@ struct ServerConfig {
   int encoder_threads = 1;
   int render_threads = 0;  // LP_NUM_THREADS for llvmpipe; 0 = leave the environment's value
   render::EglPlatformChoice renderer = render::EglPlatformChoice::kAuto;
+  render::SpraySmoothing spray_smoothing = render::SpraySmoothing::kPlaneFit;
   std::string log_level = "info";
   double stats_interval_s = 30.0;
   // A session whose clients have all gone quiet (no request, no Drive stream) this long is

@@ -55,6 +55,8 @@ struct FrameResources {
   TargetTexture glass_water;      // the session's glass water map
   TargetTexture road_reflection;  // drawn before the passes where the view reads it
   TargetTexture road_reflection_depth;
+  GLuint spray_layer_fbo = 0;
+  TargetTexture spray_layer;
 };
 
 // Resources made once and shared by the passes.

@@ -21,6 +21,8 @@ std::string_view resource_name(Resource r) {
       return "road water";
     case Resource::kRoadReflection:
       return "road reflection";
+    case Resource::kSprayLayer:
+      return "spray layer";
   }
   return "?";
 }

@@ -25,8 +25,9 @@ enum class Resource : std::uint8_t {
   // The scene mirrored in the road's plane with its depth, a quarter of the view: the renderer
   // draws it before the view's passes where one reads it and the road is wet.
   kRoadReflection,
+  kSprayLayer,  // the spray over the scene, half the view, premultiplied
 };
-inline constexpr std::size_t kResourceCount = 7;
+inline constexpr std::size_t kResourceCount = 8;
 std::string_view resource_name(Resource resource);
 
 struct PassDecl {

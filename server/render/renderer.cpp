@@ -23,6 +23,7 @@
 #include "server/render/passes/rain_pass.hpp"
 #include "server/render/passes/road_pass.hpp"
 #include "server/render/passes/sky_pass.hpp"
+#include "server/render/passes/spray_pass.hpp"
 #include "server/render/passes/terrain_pass.hpp"
 #include "server/render/passes/vehicle_pass.hpp"
 #include "server/render/passes/windshield_pass.hpp"
@@ -156,6 +157,8 @@ GLuint unit_of(Resource r) {
       return texture_unit::kRoadWater;
     case Resource::kRoadReflection:
       return texture_unit::kReflection;
+    case Resource::kSprayLayer:
+      return texture_unit::kSprayLayer;
   }
   return 0;
 }
@@ -193,6 +196,7 @@ struct Renderer::Impl {
   std::uint64_t frame = 0;                       // frames rendered, for the transients' use
   std::unique_ptr<RenderSession> image_session;  // render_image's
   RainPass* rain = nullptr;                      // one of passes
+  SprayPass* spray = nullptr;                    // likewise
   std::uint32_t rain_streaks = 0;                // drawn by the last render()
   // What the road reflection draws, mirrored (passes of the views), each clipped to this far above
   // the mirror's plane; and the views that read it.
@@ -434,7 +438,9 @@ struct Renderer::Impl {
     // A transient that no pass of this frame drew (its pass had nothing to draw) leaves its
     // readers nothing to draw either.
     for (Resource res : d.reads) {
-      if ((res == Resource::kSceneBlur || res == Resource::kGlassLayer) && !written[index(res)])
+      if ((res == Resource::kSceneBlur || res == Resource::kGlassLayer ||
+           res == Resource::kSprayLayer) &&
+          !written[index(res)])
         return;
     }
     for (Resource res : d.reads) {
@@ -465,6 +471,9 @@ struct Renderer::Impl {
           texture = r.road_reflection.texture;
           glBindTextureUnit(texture_unit::kReflectionDepth, r.road_reflection_depth.texture);
           break;
+        case Resource::kSprayLayer:
+          texture = r.spray_layer.texture;
+          break;
       }
       glBindTextureUnit(unit_of(res), texture);
     }
@@ -474,12 +483,19 @@ struct Renderer::Impl {
       glViewport(0, 0, r.view_colour.width, r.view_colour.height);
     } else {
       const int w = r.view_colour.width, h = r.view_colour.height;
-      const int scale = out == Resource::kSceneBlur ? kSceneBlurScale : f.glass.layer_scale();
+      const int scale = out == Resource::kSceneBlur    ? kSceneBlurScale
+                        : out == Resource::kSprayLayer ? SprayPass::kScale
+                                                       : f.glass.layer_scale();
       Transient& t = transient(out, std::max(1, (w + scale - 1) / scale),
                                std::max(1, (h + scale - 1) / scale));
-      (out == Resource::kSceneBlur ? r.scene_blur : r.glass_layer) = {t.texture.id(), t.width,
-                                                                      t.height};
-      (out == Resource::kSceneBlur ? r.scene_blur_fbo : r.glass_layer_fbo) = t.fbo.id();
+      TargetTexture& texture = out == Resource::kSceneBlur    ? r.scene_blur
+                               : out == Resource::kSprayLayer ? r.spray_layer
+                                                              : r.glass_layer;
+      GLuint& fbo = out == Resource::kSceneBlur    ? r.scene_blur_fbo
+                    : out == Resource::kSprayLayer ? r.spray_layer_fbo
+                                                   : r.glass_layer_fbo;
+      texture = {t.texture.id(), t.width, t.height};
+      fbo = t.fbo.id();
       glBindFramebuffer(GL_FRAMEBUFFER, t.fbo.id());
       glViewport(0, 0, t.width, t.height);
       const float clear[4] = {0.0f, 0.0f, 0.0f, 0.0f};
@@ -500,6 +516,7 @@ Renderer::~Renderer() = default;
 std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   auto impl = std::make_unique<Impl>();
   impl->context = EglContext::create(options.platform);
+  const SpraySmoothing smoothing = options.spray_smoothing;
 #ifndef NDEBUG
   // Debug builds: the driver's own reports of errors and misuse, in the log as they happen.
   glEnable(GL_DEBUG_OUTPUT);
@@ -543,14 +560,23 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   Pass* glass_water = impl->add<GlassWaterPass>();
   Pass* glass_composite = impl->add<GlassCompositePass>();
   Pass* windshield = impl->add<WindshieldPass>();
+  SprayPass* spray = impl->add<SprayPass>();
+  impl->spray = spray;
+  spray->set_smoothing(smoothing);
+  impl->passes.push_back(std::make_unique<SprayCompositePass>(*impl->shared, *spray));
+  Pass* spray_composite = impl->passes.back().get();
   impl->reflected = {{vehicles, -0.02f}, {terrain, 0.5f}, {sky, 0.0f}};
   auto& views = impl->views;
   views[static_cast<int>(sim::View::kCockpit)] = {
-      cockpit, vehicles, road, terrain, sky, rain, glass_background, glass_water, glass_composite};
-  views[static_cast<int>(sim::View::kRoad)] = {vehicles, road, terrain, sky, rain};
+      cockpit,         vehicles,         road,        terrain,        sky, rain, spray,
+      spray_composite, glass_background, glass_water, glass_composite};
+  views[static_cast<int>(sim::View::kRoad)] = {vehicles, road,  terrain,        sky,
+                                               rain,     spray, spray_composite};
   views[static_cast<int>(sim::View::kWindshield)] = {windshield};
-  // The rain layer alone from the driver's eye: the scene for its depth, then black, then rain.
-  views[static_cast<int>(sim::View::kRain)] = {cockpit, vehicles, road, terrain, rain_mask, rain};
+  // The rain layer alone from the driver's eye: the scene for its depth, then black, then rain and
+  // spray.
+  views[static_cast<int>(sim::View::kRain)] = {cockpit,   vehicles, road,  terrain,
+                                               rain_mask, rain,     spray, spray_composite};
   for (int v = 0; v < sim::kViewCount; ++v) {
     check_pass_order(sim::view_name(static_cast<sim::View>(v)), views[v]);
     for (const Pass* pass : views[v]) {
@@ -568,6 +594,22 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
 const std::string& Renderer::gl_renderer() const { return impl_->context->renderer(); }
 const std::string& Renderer::platform() const { return impl_->context->platform(); }
 void Renderer::set_profiling(bool on) { impl_->profiling = on; }
+void Renderer::set_spray_smoothing(SpraySmoothing smoothing) {
+  impl_->spray->set_smoothing(smoothing);
+}
+SpraySmoothing Renderer::spray_smoothing() const { return impl_->spray->smoothing(); }
+void Renderer::set_spray_cpu_splat(bool cpu) { impl_->spray->set_cpu_splat(cpu); }
+bool Renderer::spray_cpu_splat() const { return impl_->spray->cpu_splat(); }
+std::vector<float> Renderer::smooth_spray_body(int width, int height, float tan_x, float tan_y,
+                                               const std::vector<float>& front) {
+  if (width <= 0 || height <= 0 || front.size() != static_cast<std::size_t>(width) * height)
+    throw std::invalid_argument("smooth_spray_body: the depths do not fill the size");
+  return impl_->spray->smooth_body_depth(width, height, glm::vec2(tan_x, tan_y), front);
+}
+std::array<std::uint32_t, 3> Renderer::last_spray_drawn() const {
+  const SprayPass::Drawn& d = impl_->spray->drawn();
+  return {d.body, d.spray, d.haze};
+}
 const std::vector<PassTiming>& Renderer::last_pass_timings() const { return impl_->timings; }
 std::uint32_t Renderer::last_rain_streaks() const { return impl_->rain_streaks; }
 

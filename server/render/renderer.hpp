@@ -3,6 +3,7 @@
 // Plain C++ interface, no GL types: the session layer drives it from the render thread.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "server/render/egl_context.hpp"
+#include "server/render/spray_smoothing.hpp"
 #include "server/sim/simulation.hpp"
 #include "server/sim/types.hpp"
 
@@ -17,6 +19,7 @@ namespace downpour::render {
 
 struct RendererOptions {
   EglPlatformChoice platform = EglPlatformChoice::kAuto;
+  SpraySmoothing spray_smoothing = SpraySmoothing::kPlaneFit;
 };
 
 struct PassTiming {
@@ -70,6 +73,19 @@ class Renderer {
   // llvmpipe a finish mid-frame leaves the context several times slower from then on, so profile
   // with a renderer of its own and take the times as a ranking of the passes.
   void set_profiling(bool on);
+  // Seed 001's smoothing of the spray's body (RendererOptions::spray_smoothing at start).
+  void set_spray_smoothing(SpraySmoothing smoothing);
+  SpraySmoothing spray_smoothing() const;
+  // Whether the CPU draws the spray's parcels (llvmpipe's choice) or the GPU.
+  void set_spray_cpu_splat(bool cpu);
+  bool spray_cpu_splat() const;
+  // The spray's parcels the last frame drew: the body's, lone spray, clouds of haze.
+  std::array<std::uint32_t, 3> last_spray_drawn() const;
+  // Tests: a body's front distances along the view axis (width x height, bottom row first, 1e6
+  // where none) smoothed as the spray pass smooths them, seen through a camera with these tangents
+  // of its half fields of view.
+  std::vector<float> smooth_spray_body(int width, int height, float tan_half_fov_x,
+                                       float tan_half_fov_y, const std::vector<float>& front);
   const std::vector<PassTiming>& last_pass_timings() const;
   // Rain streaks drawn by the last render() (0 if it drew no rain).
   std::uint32_t last_rain_streaks() const;

@@ -27,7 +27,16 @@ namespace downpour::render {
     "the road's water in rings around the car, a layer per ring: r water, g standing water (mm)") \
   X(kReflection, 10, sampler2D, reflection_tex,                                                   \
     "the scene mirrored in the road's plane, reduced size, mipmapped (display-encoded)")          \
-  X(kReflectionDepth, 11, sampler2D, reflection_depth_tex, "its depth (reversed-Z)")
+  X(kReflectionDepth, 11, sampler2D, reflection_depth_tex, "its depth (reversed-Z)")              \
+  X(kSprayDepth, 12, sampler2D, spray_depth_tex,                                                  \
+    "the spray's depth maps (seed 001): r body front, g body back, b spray front, a spray "       \
+    "back; distances (m), backs negated")                                                         \
+  X(kSpraySmooth, 13, sampler2D, spray_smooth_tex,                                                \
+    "the body's front distance (r), being smoothed or smoothed")                                  \
+  X(kSprayLayer, 14, sampler2D, spray_layer_tex,                                                  \
+    "the spray over the scene, reduced size, premultiplied")                                      \
+  X(kSprayHaze, 15, sampler2D, spray_haze_tex,                                                    \
+    "the spray's haze, a quarter of the view: r optical depth, g that times distance (m)")
 
 // The per-frame uniform block: X(GLSL type, name, comment). Every field is a vec4 or a mat4, so
 // the C++ struct below has the std140 layout as it is.

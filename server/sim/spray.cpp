@@ -18,6 +18,9 @@ constexpr double kAirDensity = 1.2;       // kg/m^3
 constexpr double kAirViscosity = 1.8e-5;  // Pa s
 constexpr double kWaterDensity = 1000.0;
 constexpr double kDeg = M_PI / 180.0;
+// A body's parcels are drawn at least this share of the neighbour radius: parcels of a sheet,
+// about half that apart, overlap.
+constexpr double kSheetRadius = 0.35;
 // The renderer's car is the ego car's shape scaled to a traffic vehicle's size by these.
 constexpr double kCarLength = 4.6, kCarWidth = 1.8, kCarHeight = 1.47;
 
@@ -62,7 +65,32 @@ struct Spray::Pose {
   }
 };
 
-Spray::Spray(std::uint64_t seed, SprayConfig config) : config_(config), random_(seed, 5) {}
+Spray::Spray(std::uint64_t seed, SprayConfig config) : config_(config), random_(seed, 5) {
+  // Drag toward the air (Schiller-Naumann: the Stokes rate times 1 + 0.15 Re^0.687), exact over a
+  // step for a constant rate: tabulated by the relative speed for each kind, so that a step takes
+  // no pow() or exp() per parcel.
+  for (int k = 0; k < kSprayKinds; ++k) {
+    const double d = config_.diameter_mm[k] * 1e-3;
+    const double stokes = 18.0 * kAirViscosity / (kWaterDensity * d * d);
+    for (int i = 0; i <= kDragSteps; ++i) {
+      const double re = kAirDensity * (i * kDragSpeedStep) * d / kAirViscosity;
+      Drag& g = drag_[k][i];
+      g.rate = stokes * (1.0 + 0.15 * std::pow(re, 0.687));
+      g.decay = std::exp(-g.rate * config_.step_s);
+      g.gone = (1.0 - g.decay) / g.rate;
+    }
+  }
+}
+
+Spray::Drag Spray::drag_at(int kind, double speed) const {
+  const double x = std::min(speed / kDragSpeedStep, kDragSteps - 1e-9);
+  const int i = static_cast<int>(x);
+  const double f = x - i;
+  const Drag& a = drag_[kind][i];
+  const Drag& b = drag_[kind][i + 1];
+  return {a.rate + (b.rate - a.rate) * f, a.decay + (b.decay - a.decay) * f,
+          a.gone + (b.gone - a.gone) * f};
+}
 
 double Spray::airborne_m3() const {
   double sum = 0.0;
@@ -136,7 +164,7 @@ void Spray::emit(const Pose& v, SprayGround& ground) {
           c.peak_deg * kDeg * -std::log(random_.uniform(1e-12, 1.0) * random_.uniform(1e-12, 1.0));
       const double across = random_.uniform(-0.5, 0.5) * width;
       const double keep = random_.uniform(0.75, 1.0) * slow;
-      const double out = random_.uniform(0.0, 0.2);
+      const double out = random_.uniform(0.0, 0.08);
       if (phi > c.mudguard_deg * kDeg) return;  // blocked: it stays on the road
       SprayParticle p;
       p.position_m = contact + up * radius +
@@ -217,12 +245,6 @@ void Spray::step(const std::vector<SpraySource>& sources, glm::dvec3 wind, Spray
   const glm::dvec3 ego_before = ego ? ego->position - ego->velocity * dt : glm::dvec3(0.0);
   const glm::dvec3 glass_normal = glass ? glass->normal() : glm::dvec3(0.0);
 
-  // Drag toward the air (Schiller-Naumann), exact over the step for a constant rate.
-  std::array<double, kSprayKinds> stokes{};
-  for (int k = 0; k < kSprayKinds; ++k) {
-    const double d = c.diameter_mm[k] * 1e-3;
-    stokes[k] = 18.0 * kAirViscosity / (kWaterDensity * d * d);
-  }
   const glm::dvec3 gravity(0.0, 0.0, -kGravity);
   const double eddy_keep = std::exp(-dt / c.eddy_s);
   std::size_t kept = 0;
@@ -242,14 +264,11 @@ void Spray::step(const std::vector<SpraySource>& sources, glm::dvec3 wind, Spray
                            kick * glm::dvec3(random_.uniform(-1.0, 1.0), random_.uniform(-1.0, 1.0),
                                              random_.uniform(-1.0, 1.0)));
     air += glm::dvec3(p.eddy_mps);
-    const double relative = glm::length(air - p.velocity_mps);
-    const double re = kAirDensity * relative * c.diameter_mm[k] * 1e-3 / kAirViscosity;
-    const double rate = stokes[k] * (1.0 + 0.15 * std::pow(re, 0.687));
-    const glm::dvec3 settled = air + gravity / rate;
-    const double decay = std::exp(-rate * dt);
+    const Drag drag = drag_at(k, glm::length(air - p.velocity_mps));
+    const glm::dvec3 settled = air + gravity / drag.rate;
     const glm::dvec3 before = p.position_m;
-    p.position_m += settled * dt + (p.velocity_mps - settled) * ((1.0 - decay) / rate);
-    p.velocity_mps = settled + (p.velocity_mps - settled) * decay;
+    p.position_m += settled * dt + (p.velocity_mps - settled) * drag.gone;
+    p.velocity_mps = settled + (p.velocity_mps - settled) * drag.decay;
     p.age_s += static_cast<float>(dt);
 
     bool gone = false;
@@ -325,15 +344,78 @@ void Spray::step(const std::vector<SpraySource>& sources, glm::dvec3 wind, Spray
 }
 
 void Spray::image(glm::dvec3 origin, SprayImage& out) const {
+  const SprayConfig& c = config_;
   out.origin_m = origin;
   out.points.clear();
   out.points.reserve(particles_.size());
   out.counts = {};
   for (const SprayParticle& p : particles_) {
     const glm::dvec3 r = p.position_m - origin;
+    const int k = static_cast<int>(p.kind);
+    const double size = radius_m(p);
+    // Droplets of diameter d holding V spread evenly over a sphere of radius R: n = 6V / (pi d^3)
+    // / (4/3 pi R^3), extinction n pi d^2 / 2, through the centre (2R): 9 V / (2 pi d R^2).
+    const double d = c.diameter_mm[k] * 1e-3;
+    const double haze = 9.0 * p.volume_m3 / (2.0 * M_PI * d * size * size);
+    const double gathered = std::cbrt(3.0 * p.volume_m3 / (4.0 * M_PI));
+    const double liquid = p.kind == SprayKind::kMist ? 0.0 : std::min(gathered, size);
     out.points.push_back({static_cast<float>(r.x), static_cast<float>(r.y), static_cast<float>(r.z),
-                          static_cast<float>(radius_m(p)), p.kind, p.splash});
-    ++out.counts[static_cast<int>(p.kind)];
+                          static_cast<float>(size), static_cast<float>(liquid),
+                          static_cast<float>(haze), p.kind, p.splash, false});
+    ++out.counts[k];
+  }
+  classify(out);
+}
+
+// Body or spray: neighbours counted in a hash of cells as wide as the neighbour radius (the 27
+// cells around a parcel hold every neighbour), liquid parcels only.
+void Spray::classify(SprayImage& out) const {
+  const double h = config_.neighbour_radius_m;
+  const float h2 = static_cast<float>(h * h);
+  const std::size_t n = out.points.size();
+  std::size_t buckets = 64;
+  while (buckets < 2 * n) buckets *= 2;
+  auto cell_of = [&](const SprayImage::Point& p) {
+    return glm::ivec3(static_cast<int>(std::floor(p.x / h)), static_cast<int>(std::floor(p.y / h)),
+                      static_cast<int>(std::floor(p.z / h)));
+  };
+  auto bucket = [&](glm::ivec3 q) {
+    const std::uint64_t key = static_cast<std::uint64_t>(q.x) * 73856093u ^
+                              static_cast<std::uint64_t>(q.y) * 19349663u ^
+                              static_cast<std::uint64_t>(q.z) * 83492791u;
+    return static_cast<std::size_t>(key & (buckets - 1));
+  };
+  // Counting sort of the liquid parcels by bucket.
+  std::vector<std::uint32_t> start(buckets + 1, 0), order;
+  order.reserve(n);
+  for (const SprayImage::Point& p : out.points)
+    if (p.kind != SprayKind::kMist) ++start[bucket(cell_of(p)) + 1];
+  for (std::size_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
+  order.resize(start[buckets]);
+  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (out.points[i].kind != SprayKind::kMist)
+      order[fill[bucket(cell_of(out.points[i]))]++] = static_cast<std::uint32_t>(i);
+  }
+  for (SprayImage::Point& p : out.points) {
+    if (p.kind == SprayKind::kMist) continue;
+    const glm::ivec3 q = cell_of(p);
+    int found = -1;  // the parcel itself is among them
+    for (int dz = -1; dz <= 1 && found < config_.body_neighbours; ++dz) {
+      for (int dy = -1; dy <= 1 && found < config_.body_neighbours; ++dy) {
+        for (int dx = -1; dx <= 1 && found < config_.body_neighbours; ++dx) {
+          const std::size_t b = bucket(q + glm::ivec3(dx, dy, dz));
+          for (std::uint32_t k = start[b]; k < start[b + 1]; ++k) {
+            const SprayImage::Point& o = out.points[order[k]];
+            const float ex = o.x - p.x, ey = o.y - p.y, ez = o.z - p.z;
+            found += ex * ex + ey * ey + ez * ez <= h2;
+          }
+        }
+      }
+    }
+    p.body = found >= config_.body_neighbours;
+    // A body is a sheet: its parcels overlap, so that its surface is one.
+    if (p.body) p.liquid_radius_m = std::max(p.liquid_radius_m, static_cast<float>(0.5 * h));
   }
 }
 

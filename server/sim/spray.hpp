@@ -64,8 +64,8 @@ struct SprayConfig {
   // Droplet diameters of each kind (drag, and what a glass hit leaves), mm.
   std::array<double, kSprayKinds> diameter_mm{0.05, 0.25, 0.7, 2.0};
   // A parcel's drawn size: the radius it is born with and how fast it spreads, m and m/s.
-  std::array<double, kSprayKinds> radius_m{0.10, 0.03, 0.035, 0.04};
-  std::array<double, kSprayKinds> spread_mps{0.30, 0.06, 0.04, 0.02};
+  std::array<double, kSprayKinds> radius_m{0.2, 0.08, 0.1, 0.12};
+  std::array<double, kSprayKinds> spread_mps{0.30, 0.15, 0.12, 0.08};
   // The share of a parcel's water that stays on the windshield when it crosses it.
   std::array<double, kSprayKinds> glass_capture{0.3, 0.7, 0.9, 1.0};
 
@@ -84,8 +84,8 @@ struct SprayConfig {
   double mudguard_deg = 75.0;  // above this the mudguard blocks the arc
   // Parcels per tire per second at full flow (1 - exp(-flow / flow_ref)).
   double tire_parcels_per_s = 300.0;
-  double mist_parcels_per_s = 60.0;
-  double splash_parcels_per_s = 250.0;
+  double mist_parcels_per_s = 200.0;
+  double splash_parcels_per_s = 1200.0;
   double flow_ref_m3_s = 2e-4;
 
   // The wake: air dragged behind a vehicle at up to wake_fraction of its velocity, fading over
@@ -97,13 +97,16 @@ struct SprayConfig {
   // with this correlation time), by turbulence_mps in still air and by wake_turbulence of the
   // vehicle's speed in its wake, so that a wake mixes its spray across its width.
   double turbulence_mps = 0.5;
-  double wake_turbulence = 0.15;
-  double eddy_s = 0.3;
+  double wake_turbulence = 0.08;
+  double eddy_s = 0.2;
 
   double mist_life_s = 4.0;
   double max_life_s = 8.0;
   double max_range_m = 250.0;  // farther from the ego car a parcel is let go
   double glass_drop_mg = 4.0;  // a glass hit leaves drops of at most this, up to 16 of them
+  // Body or spray (seed 001): a liquid parcel with this many others this near is in a body.
+  double neighbour_radius_m = 0.2;
+  int body_neighbours = 8;
 };
 
 // What throws spray: the ego car (key 0) and each traffic vehicle (key id + 1), posed as in the
@@ -173,14 +176,22 @@ struct SprayLedger {
   double dropped_m3 = 0.0;    // parcels let go: the budget, their age, their range
 };
 
-// The parcels for the renderer: positions relative to `origin_m` (the ego car's reference point
-// when taken), drawn radius, kind.
+// The parcels for the renderer (seed 001's input), positions relative to `origin_m` (the ego
+// car's reference point when taken). Each parcel is a cloud of droplets of its kind's size spread
+// over radius_m: it is drawn as a haze of that size whose optical depth through its centre is
+// `haze_depth` (geometric optics: extinction twice the droplets' cross-section per volume), and,
+// but for mist, as a sphere of liquid of `liquid_radius_m` (its water gathered into one sphere).
+// `body`: the parcel has at least body_neighbours others within neighbour_radius_m (a spatial
+// hash): part of a liquid body (a splash's sheet), drawn at least a third of that radius so that
+// the sheet's parcels overlap; else lone spray.
 struct SprayImage {
   glm::dvec3 origin_m{0.0};
   struct Point {
     float x, y, z, radius_m;
+    float liquid_radius_m, haze_depth;
     SprayKind kind;
     bool splash;
+    bool body;
   };
   std::vector<Point> points;
   std::array<std::uint32_t, kSprayKinds> counts{};
@@ -210,10 +221,22 @@ class Spray {
  private:
   struct Pose;
   void emit(const Pose& source, SprayGround& ground);
+  void classify(SprayImage& out) const;
   // The air dragged along by a vehicle at p, and how strong its wake is there (0-1).
   glm::dvec3 wake(const Pose& source, glm::dvec3 p, double* strength) const;
 
+  // The drag over one step by relative speed (up to kDragSteps * kDragSpeedStep m/s): its rate
+  // (1/s), what is left of the velocity toward the air (decay), and the time the difference
+  // travels for (gone = (1 - decay) / rate).
+  struct Drag {
+    double rate = 0.0, decay = 0.0, gone = 0.0;
+  };
+  static constexpr int kDragSteps = 400;
+  static constexpr double kDragSpeedStep = 0.25;
+  Drag drag_at(int kind, double speed) const;
+
   SprayConfig config_;
+  std::array<std::array<Drag, kDragSteps + 1>, kSprayKinds> drag_{};
   RandomStream random_;
   std::vector<SprayParticle> particles_;  // oldest first
   SprayLedger ledger_;

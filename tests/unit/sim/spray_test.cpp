@@ -16,6 +16,7 @@
 #include "server/sim/road_water.hpp"
 #include "server/sim/simulation.hpp"
 #include "server/sim/track.hpp"
+#include "tests/support/spray_drive.hpp"
 
 namespace downpour::sim {
 namespace {
@@ -46,18 +47,9 @@ constexpr double kPuddleM = 0.004;   // 3.5 mm standing
 
 const Track& track() { return Track::built_in(); }
 
-// A vehicle on the track's inner lane at s, driving at speed along it.
-VehicleState on_track(double s, double speed) {
-  const TrackFrame f = track().at(s);
-  VehicleState v;
-  const glm::dvec2 xy = glm::dvec2(f.position) + f.left * track().lane_centre(0);
-  v.position_m = glm::dvec3(xy, track().surface_height(s, track().lane_centre(0)));
-  v.rotation.yaw_deg = f.heading_rad * 180.0 / M_PI;
-  v.velocity_mps = glm::dvec3(std::cos(f.heading_rad), std::sin(f.heading_rad), 0.0) * speed;
-  return v;
-}
+using testing::on_track;
 
-const glm::dvec3 kTruck(12.0, 2.5, 3.8);
+const glm::dvec3 kTruck = testing::kTruckSize;
 
 // Drives the sources along the track for `seconds` (each keeps its speed) over `ground`.
 struct Drive {
@@ -288,35 +280,19 @@ TEST(SprayTest, ATrucksSprayHangsBehindIt) {
 // Following a truck at 25 m/s on a drenched road wets the ego car's windshield; alone, on the
 // same road in the same (light) rain, it stays far drier.
 TEST(SprayTest, FollowingATruckWetsTheGlass) {
-  auto drive = [](bool follow) {
-    SimulationConfig config;
-    config.road.initial_m = kDrenchM;
-    Update start;
-    start.vehicle = on_track(400.0, 25.0);
-    Weather w;
-    w.rain_rate_mm_h = 1.0;
-    start.weather = w;
-    Simulation sim(9, start, config);
-    double s = 400.0;
-    for (int k = 0; k < 4 * 30; ++k) {
-      s += 25.0 / 30.0;
-      Update u;
-      u.vehicle = on_track(s, 25.0);
-      if (follow) {
-        TrafficVehicle truck{1, on_track(s + 22.0, 25.0), kTruck};
-        u.traffic = std::vector<TrafficVehicle>{truck};
-      }
-      sim.apply(u);
-      sim.advance(1.0 / 30.0);
-    }
+  auto glass = [](bool follow) {
+    testing::SprayDrive d;
+    d.road_water_m = kDrenchM;
+    if (follow) d.truck_gap_m = 22.0;
+    const Simulation sim = testing::drive(d);
     const SprayLedger& l = sim.spray().ledger();
     std::printf("%s: glass wet fraction %.4f, %.2f ml of spray on it, %zu parcels\n",
                 follow ? "following a truck" : "alone", sim.state().windshield.glass_wet_fraction,
                 l.on_glass_m3 * 1e6, sim.spray().particles().size());
     return std::make_pair(sim.state().windshield.glass_wet_fraction, l.on_glass_m3);
   };
-  const auto [alone, alone_ml] = drive(false);
-  const auto [following, following_ml] = drive(true);
+  const auto [alone, alone_ml] = glass(false);
+  const auto [following, following_ml] = glass(true);
   EXPECT_GT(following_ml, 0.0);
   EXPECT_GT(following, alone + 0.02);
 }

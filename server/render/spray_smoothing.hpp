@@ -1,0 +1,18 @@
+// How the spray's liquid body depth is smoothed (seed 001, step 4): a renderer option. No GL.
+#pragma once
+
+#include <optional>
+#include <string_view>
+
+namespace downpour::render {
+
+enum class SpraySmoothing {
+  kPlaneFit,   // local plane fitting, 9 x 9, 3 passes: the paper's method, the default
+  kBilateral,  // the bilateral filter, 7 x 7, 22 passes: the paper's baseline
+  kNone,
+};
+const char* spray_smoothing_name(SpraySmoothing smoothing);
+// By name ("plane_fit", "bilateral", "none"); nullopt for another.
+std::optional<SpraySmoothing> spray_smoothing_from(std::string_view name);
+
+}  // namespace downpour::render
