@@ -1,5 +1,6 @@
 #include "server/sim/simulation.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -11,7 +12,7 @@
 namespace downpour::sim {
 namespace {
 
-constexpr double kMaxExtrapolationS = 0.5;
+constexpr double kMaxExtrapolationS = 0.5;  // a source is moved along its path at most this
 
 SimulationConfig with_spray_step(SimulationConfig config) {
   config.spray.step_s = config.sub_steps_per_spray_step * config.sub_step_s;
@@ -76,7 +77,6 @@ void Simulation::apply(const Update& update) {
   if (update.wipers) state_.wipers = *update.wipers;
   if (update.weather) state_.weather = *update.weather;
   if (update.traffic) state_.traffic = *update.traffic;
-  if (update.vehicle || update.traffic) input_time_s_ = state_.sim_time_s;
 }
 
 void Simulation::advance(double dt_s) {
@@ -86,6 +86,10 @@ void Simulation::advance(double dt_s) {
   road_ms_ = 0.0;
   spray_ms_ = 0.0;
   carry_s_ += dt_s;
+  // The inputs are where the vehicles are at the end of this advance (as the frame draws them).
+  step_end_s_ = state_.sim_time_s;
+  for (double carry = carry_s_; whole_sub_step_due(carry); carry -= config_.sub_step_s)
+    step_end_s_ += config_.sub_step_s;
   while (whole_sub_step_due(carry_s_)) {
     sub_step();
     carry_s_ -= config_.sub_step_s;
@@ -118,6 +122,9 @@ SceneState Simulation::inputs_after(double dt_s) const {
   // The road's water as the last step left it (it changes over seconds; the step may be running
   // while the road is drawn).
   inputs.road_water = state_.road_water;
+  // The spray as the last step left it, likewise: its parcels are placed in the world, and a frame
+  // old they still are where they were (the views need not wait for the step).
+  inputs.spray = state_.spray;
   inputs.sub_steps = state_.sub_steps;
   for (double carry = carry_s_ + dt_s; whole_sub_step_due(carry); carry -= config_.sub_step_s)
     ++inputs.sub_steps;
@@ -167,10 +174,12 @@ void Simulation::sub_step() {
   sub_steps_since_water_ = 0;
 }
 
-// The ego car and the traffic, each moved on from its last input at its velocity, throw spray
-// from the road's water; what crosses the glass becomes drops there.
+// The ego car and the traffic throw spray from the road's water, each where it is at this
+// sub-step: its input is its pose at the end of the advance, so it is moved back along its
+// velocity; what crosses the glass becomes drops there.
 void Simulation::spray_step() {
-  const double ahead = std::min(state_.sim_time_s - input_time_s_, kMaxExtrapolationS);
+  const double ahead =
+      std::clamp(state_.sim_time_s - step_end_s_, -kMaxExtrapolationS, kMaxExtrapolationS);
   std::vector<SpraySource> sources;
   sources.reserve(state_.traffic.size() + 1);
   auto add = [&](std::uint32_t key, const VehicleState& state, glm::dvec3 size) {

@@ -58,8 +58,8 @@ struct SceneState {
   // The road's water around the car, for drawing; shared by copies, replaced after each road
   // step (null before the first).
   std::shared_ptr<const RoadWaterImage> road_water;
-  // The spray's parcels, relative to the ego car's reference point; replaced after each advance()
-  // (null before the first).
+  // The spray's parcels, relative to the ego car's reference point when taken; replaced after each
+  // advance() (null before the first); inputs_after() carries the last one.
   std::shared_ptr<const SprayImage> spray;
 };
 
@@ -108,10 +108,9 @@ class Simulation {
   bool road_image_stale_ = true;  // a road step since state_.road_water was made
   Spray spray_;
   int sub_steps_since_spray_ = 0;
-  // The sim time of the last vehicle or traffic input: the spray's sources move on from there at
-  // their velocity (for at most kMaxExtrapolationS), so that tires throw along their path between
-  // inputs.
-  double input_time_s_ = 0.0;
+  // The sim time at the end of the advance under way: the inputs' poses are the vehicles' then,
+  // and the spray's sources are moved back along their velocity to each spray step's time.
+  double step_end_s_ = 0.0;
   double spray_ms_ = 0.0;
   AdvanceTiming timing_;
   double rain_ms_ = 0.0;  // the rain field's time in this advance, so far

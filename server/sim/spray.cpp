@@ -61,6 +61,7 @@ struct Spray::Pose {
   // The ground's height under a world point, on the plane of the vehicle's wheels.
   double ground_z(glm::dvec3 p) const {
     const glm::dvec3 n = rotation[2];
+    if (n.z < 0.2) return position.z;  // (not on its wheels: a level plane)
     return position.z - (n.x * (p.x - position.x) + n.y * (p.y - position.y)) / n.z;
   }
 };
@@ -334,7 +335,13 @@ void Spray::step(const std::vector<SpraySource>& sources, glm::dvec3 wind, Spray
   }
   particles_.resize(kept);
 
-  for (const Pose& v : poses) emit(v, ground);
+  // Vehicles far from the ego car throw nothing (their parcels would be let go by range), nor do
+  // those not on their wheels.
+  for (const Pose& v : poses) {
+    if (glm::length(v.position - poses[0].position) > c.max_range_m) continue;
+    if (v.rotation[2].z < 0.5) continue;
+    emit(v, ground);
+  }
   // Over the budget, the oldest go first (they are at the front).
   if (particles_.size() > c.max_particles) {
     const std::size_t excess = particles_.size() - c.max_particles;
@@ -400,22 +407,26 @@ void Spray::classify(SprayImage& out) const {
   for (SprayImage::Point& p : out.points) {
     if (p.kind == SprayKind::kMist) continue;
     const glm::ivec3 q = cell_of(p);
+    // The 27 cells' buckets, each once (two cells may share one).
+    std::array<std::size_t, 27> near{};
+    int count = 0;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) near[count++] = bucket(q + glm::ivec3(dx, dy, dz));
+    std::sort(near.begin(), near.end());
+    const auto end = std::unique(near.begin(), near.end());
     int found = -1;  // the parcel itself is among them
-    for (int dz = -1; dz <= 1 && found < config_.body_neighbours; ++dz) {
-      for (int dy = -1; dy <= 1 && found < config_.body_neighbours; ++dy) {
-        for (int dx = -1; dx <= 1 && found < config_.body_neighbours; ++dx) {
-          const std::size_t b = bucket(q + glm::ivec3(dx, dy, dz));
-          for (std::uint32_t k = start[b]; k < start[b + 1]; ++k) {
-            const SprayImage::Point& o = out.points[order[k]];
-            const float ex = o.x - p.x, ey = o.y - p.y, ez = o.z - p.z;
-            found += ex * ex + ey * ey + ez * ez <= h2;
-          }
-        }
+    for (auto b = near.begin(); b != end && found < config_.body_neighbours; ++b) {
+      for (std::uint32_t k = start[*b]; k < start[*b + 1]; ++k) {
+        const SprayImage::Point& o = out.points[order[k]];
+        const float ex = o.x - p.x, ey = o.y - p.y, ez = o.z - p.z;
+        found += ex * ex + ey * ey + ez * ez <= h2;
       }
     }
     p.body = found >= config_.body_neighbours;
     // A body is a sheet: its parcels overlap, so that its surface is one.
-    if (p.body) p.liquid_radius_m = std::max(p.liquid_radius_m, static_cast<float>(0.5 * h));
+    if (p.body)
+      p.liquid_radius_m = std::max(p.liquid_radius_m, static_cast<float>(kSheetRadius * h));
   }
 }
 

@@ -29,8 +29,9 @@
 // as the paper has it (they would only wet it again). Mist expires after `mist_life_s`.
 //
 // The glass. A parcel that crosses the ego car's windshield leaves a share of its water there (the
-// rest flows around with the air: mist mostly does) as drops of at most `glass_drop_mg` spread over
-// the parcel's size; one that meets the rest of the ego car's body is gone.
+// rest flows around with the air: mist mostly does) as drops of `glass_drop_mg` (at most 16 of
+// them, larger for a parcel that holds more) spread over the parcel's size; one that meets the
+// rest of the ego car's body is gone.
 //
 // Bounded: at most `max_particles` parcels; when full, the oldest go first. Deterministic: one
 // random stream of the session's seed, sources and parcels in a fixed order. No GL.
@@ -103,7 +104,7 @@ struct SprayConfig {
   double mist_life_s = 4.0;
   double max_life_s = 8.0;
   double max_range_m = 250.0;  // farther from the ego car a parcel is let go
-  double glass_drop_mg = 4.0;  // a glass hit leaves drops of at most this, up to 16 of them
+  double glass_drop_mg = 4.0;  // a glass hit leaves drops of this, up to 16 (then larger ones)
   // Body or spray (seed 001): a liquid parcel with this many others this near is in a body.
   double neighbour_radius_m = 0.2;
   int body_neighbours = 8;

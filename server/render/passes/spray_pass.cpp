@@ -93,7 +93,8 @@ SprayPass::SprayPass(SharedResources&)
       haze_program_("spray_haze.vert", "spray_haze.frag"),
       haze_composite_program_("spray_runs.vert", "spray_haze_composite.frag"),
       u_depth_projection_(depth_program_.uniform("u_projection")),
-      u_depth_body_(depth_program_.uniform("u_body_count")),
+      u_depth_spray_(depth_program_.uniform("u_spray_count")),
+      u_depth_near_(depth_program_.uniform("u_near")),
       u_plane_size_(plane_program_.uniform("u_size")),
       u_plane_tan_(plane_program_.uniform("u_tan")),
       u_plane_sigma_(plane_program_.uniform("u_sigma")),
@@ -133,7 +134,7 @@ SprayPass::SprayPass(SharedResources&)
 }
 
 bool SprayPass::wanted(const FrameContext& frame) const {
-  const sim::SprayImage* image = frame.stepped().spray.get();
+  const sim::SprayImage* image = frame.scene.spray.get();
   return image && !image->points.empty();
 }
 
@@ -167,6 +168,10 @@ SprayPass::Targets& SprayPass::targets(int width, int height) {
   t->haze_width = std::max(1, (width + kHazeScale - 1) / kHazeScale);
   t->haze_height = std::max(1, (height + kHazeScale - 1) / kHazeScale);
   make(GL_RG32F, t->haze_width, t->haze_height, true, t->haze, t->haze_fbo);
+  GLuint id = 0;
+  glCreateFramebuffers(1, &id);
+  t->shade_fbo = Framebuffer(id);
+  glNamedFramebufferTexture(id, GL_DEPTH_ATTACHMENT, t->mask.id(), 0);
   targets_.push_back(std::move(t));
   return *targets_.back();
 }
@@ -197,19 +202,24 @@ void SprayPass::depth_maps(const FrameContext& frame, Targets& t) {
   glViewport(0, 0, t.width, t.height);
   const float far[4] = {kFar, kFar, kFar, kFar};
   const float no_hit = 0.0f;
+  // (A depth clear obeys the depth mask: writes on first.)
+  apply(RenderState{DepthTest::kNearer, true, Blend::kOff});
   glClearNamedFramebufferfv(t.depth_fbo.id(), GL_COLOR, 0, far);
   glClearNamedFramebufferfv(t.depth_fbo.id(), GL_DEPTH, 0, &no_hit);
+  // The spray's parcels first, then the body's: each hit leaves its kind in the mask and passes a
+  // greater-or-equal test (a failed test would drop the fragment before MIN blending), so the
+  // mask ends with the body's mark over the spray's; MIN keeps the nearest front and, by the
+  // sign, the farthest back.
   packed_.clear();
-  for (const auto* list : {&body_, &spray_})
+  for (const auto* list : {&spray_, &body_})
     for (const SprayBall& b : *list) packed_.emplace_back(b.centre, b.radius);
   upload(parcels_, packed_.data(), packed_.size() * sizeof(glm::vec4));
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, parcels_.id());
   depth_program_.use();
   u_depth_projection_.set(frame.camera.projection);
-  u_depth_body_.set(static_cast<int>(body_.size()));
-  // Each hit leaves its kind in the mask (the greatest: the body's over the spray's); MIN keeps
-  // the nearest front and, by the sign, the farthest back.
-  apply(RenderState{DepthTest::kNearer, true, Blend::kOff});
+  u_depth_spray_.set(static_cast<int>(spray_.size()));
+  u_depth_near_.set(frame.camera.near_m);
+  glDepthFunc(GL_GEQUAL);
   glEnable(GL_BLEND);
   glBlendEquation(GL_MIN);
   glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, static_cast<GLsizei>(packed_.size()));
@@ -308,7 +318,7 @@ std::vector<float> SprayPass::smooth_body_depth(int width, int height, glm::vec2
 
 void SprayPass::execute(const FrameContext& frame, const FrameResources& resources) {
   drawn_ = {};
-  const sim::SprayImage& image = *frame.stepped().spray;
+  const sim::SprayImage& image = *frame.scene.spray;
   const Camera& camera = frame.camera;
   const int width = std::max(1, (resources.view_colour.width + kScale - 1) / kScale);
   const int height = std::max(1, (resources.view_colour.height + kScale - 1) / kScale);
@@ -374,9 +384,12 @@ void SprayPass::execute(const FrameContext& frame, const FrameResources& resourc
     const SprayCamera layer{width, height, glm::vec2(tan_x, tan_y)};
     const SprayCamera quarter{t.haze_width, t.haze_height, glm::vec2(tan_x, tan_y)};
     // The haze on the helper thread while this one draws the liquid's maps.
-    helper_.start([&] { splat_haze(quarter, clouds_, haze_pixels_); });
+    helper_.start([this, quarter] { splat_haze(quarter, clouds_, haze_pixels_); });
+    struct Join {
+      sim::WorkerThread& helper;
+      ~Join() { helper.wait(); }  // before anything it reads goes, even if this throws
+    } join{helper_};
     splat_depth(layer, body_, spray_, maps_);
-    helper_.wait();
     for (int y = 0; y < height; ++y) {
       for (int x = 0; x < width; ++x) {
         if (maps_.mask[static_cast<std::size_t>(y) * width + x] > 0.0f)
@@ -414,14 +427,10 @@ void SprayPass::execute(const FrameContext& frame, const FrameResources& resourc
     // The liquid's colour into the layer, where a sphere was hit.
     glBindTextureUnit(texture_unit::kSprayDepth, t.depth.id());
     glBindTextureUnit(texture_unit::kSpraySmooth, body_front);
-    if (t.shade_layer != resources.spray_layer.texture) {
-      GLuint id = 0;
-      glCreateFramebuffers(1, &id);
-      t.shade_fbo = Framebuffer(id);
-      glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0, resources.spray_layer.texture, 0);
-      glNamedFramebufferTexture(id, GL_DEPTH_ATTACHMENT, t.mask.id(), 0);
-      t.shade_layer = resources.spray_layer.texture;
-    }
+    // (Attached each frame: the renderer may have replaced the layer's texture under the same
+    // name.)
+    glNamedFramebufferTexture(t.shade_fbo.id(), GL_COLOR_ATTACHMENT0, resources.spray_layer.texture,
+                              0);
     glBindFramebuffer(GL_FRAMEBUFFER, t.shade_fbo.id());
     glViewport(0, 0, width, height);
     // The runs at depth 0 pass only where a hit left more (llvmpipe rejects the rest before

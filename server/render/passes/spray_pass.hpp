@@ -56,8 +56,7 @@ class SprayPass final : public Pass {
   const PassDecl decl_{"spray",
                        {Resource::kViewColour, Resource::kViewDepth},
                        {Resource::kSprayLayer},
-                       {DepthTest::kOff, false, Blend::kOff},
-                       true};
+                       {DepthTest::kOff, false, Blend::kOff}};
   struct Targets {
     int width = 0, height = 0;
     Texture depth;  // RGBA32F, the four maps
@@ -69,7 +68,6 @@ class SprayPass final : public Pass {
     Texture haze;  // RG32F: optical depth, and times distance
     Framebuffer haze_fbo;
     // The layer (a transient of the renderer's) with the mask, to shade only where hit.
-    GLuint shade_layer = 0;
     Framebuffer shade_fbo;
   };
   Targets& targets(int width, int height);
@@ -82,7 +80,7 @@ class SprayPass final : public Pass {
 
   ShaderProgram depth_program_, plane_program_, bilateral_program_, shade_program_, haze_program_,
       haze_composite_program_;
-  Uniform u_depth_projection_, u_depth_body_;
+  Uniform u_depth_projection_, u_depth_spray_, u_depth_near_;
   Uniform u_plane_size_, u_plane_tan_, u_plane_sigma_, u_plane_shift_;
   Uniform u_bilateral_size_, u_bilateral_sigma_px_, u_bilateral_sigma_z_;
   Uniform u_shade_size_, u_shade_tan_, u_shade_to_world_, u_shade_near_, u_shade_scale_,

@@ -243,6 +243,8 @@ TEST(SprayTest, TheSameInputsGiveTheSameSpray) {
     return drive.spray.particles();
   };
   const auto a = run(11), b = run(11), c = run(12);
+  ASSERT_FALSE(a.empty());
+  ASSERT_FALSE(c.empty());
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     EXPECT_EQ(a[i].position_m, b[i].position_m);
