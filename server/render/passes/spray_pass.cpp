@@ -390,6 +390,7 @@ void SprayPass::execute(const FrameContext& frame, const FrameResources& resourc
       ~Join() { helper.wait(); }  // before anything it reads goes, even if this throws
     } join{helper_};
     splat_depth(layer, body_, spray_, maps_);
+    helper_.wait();
     for (int y = 0; y < height; ++y) {
       for (int x = 0; x < width; ++x) {
         if (maps_.mask[static_cast<std::size_t>(y) * width + x] > 0.0f)
