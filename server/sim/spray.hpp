@@ -24,15 +24,16 @@
 // its height, and lifted near its back (so that spray hangs behind a truck at its height), with
 // eddies whose strength follows the wake's, which mix its spray across its width (the drag
 // decides how much a droplet follows them: mist all, large drops little). Large droplets that
-// land give their water
-// back to the road cell they land on (table 1's last column); smaller ones are lost to the road
-// as the paper has it (they would only wet it again). Mist expires after `mist_life_s`.
+// land give their water back to the road cell they land on (table 1's last column); smaller ones
+// are lost to the road as the paper has it (they would only wet it again). Mist expires after
+// `mist_life_s`.
 //
 // The glass. A parcel that crosses the ego car's windshield leaves a share of its water there (the
 // rest flows around with the air: mist mostly does) as drops of `glass_drop_mg` (at most 16 of
 // them, larger for a parcel that holds more) spread over the parcel's size; one that meets the
 // rest of the ego car's body is gone.
 //
+// Vehicles farther than `max_range_m` from the ego car, or not on their wheels, throw nothing.
 // Bounded: at most `max_particles` parcels; when full, the oldest go first. Deterministic: one
 // random stream of the session's seed, sources and parcels in a fixed order. No GL.
 #pragma once

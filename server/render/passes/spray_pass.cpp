@@ -22,12 +22,11 @@ constexpr float kBodyRadiusM = 0.04f;
 constexpr float kSmoothedFromPx = 2.0f;  // a body's sphere of a smaller radius is drawn as spray
 // Road spray is dirty water: absorption per metre, red most (pure water's is far less).
 const glm::vec3 kAbsorption(3.0f, 2.0f, 1.6f);
-constexpr float kHazeSoftM = 1.0f;
+constexpr float kHazeSoftM = 1.0f;  // the haze fades over this where the scene comes nearer
 // A parcel stands for a cloud of droplets, not a ball of white: its optical depth is capped, so
 // that a dense cloud is dense by the parcels that overlap in it.
 constexpr float kMaxCloudDepth = 1.5f;
-constexpr float kHazeVisible = 0.004f;  // optical depth below which the haze is not composited  //
-                                        // the haze fades over this where the scene comes nearer
+constexpr float kHazeVisible = 0.004f;  // optical depth below which the haze is not composited
 
 // Marks the tiles a screen circle (pixels) touches.
 void mark(std::vector<std::uint8_t>& tiles, int tiles_x, int tiles_y, glm::vec2 centre,
