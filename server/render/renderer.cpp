@@ -637,6 +637,11 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
     if (target && target->busy())
       throw std::logic_error("render target resized with a readback in flight");
     target = std::make_unique<ViewTarget>(spec.width, spec.height);
+    // The spray's targets and buffers for this size now, not when the first spray shows (a
+    // session's memory is taken when its views are).
+    const auto& passes = m.views[static_cast<int>(spec.view)];
+    if (std::find(passes.begin(), passes.end(), m.spray) != passes.end())
+      m.spray->prepare(spec.width, spec.height);
   }
   const int slot = target->next_slot;
   target->next_slot = (slot + 1) % kReadbackSlots;

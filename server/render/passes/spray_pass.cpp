@@ -132,6 +132,21 @@ SprayPass::SprayPass(SharedResources&)
   }
 }
 
+void SprayPass::prepare(int view_width, int view_height) {
+  const int width = std::max(1, (view_width + kScale - 1) / kScale);
+  const int height = std::max(1, (view_height + kScale - 1) / kScale);
+  const Targets& t = targets(width, height);
+  const std::size_t pixels = static_cast<std::size_t>(width) * height;
+  maps_.depth.assign(std::max(maps_.depth.size(), pixels), glm::vec4(kFar));
+  maps_.mask.assign(std::max(maps_.mask.size(), pixels), 0.0f);
+  haze_pixels_.assign(
+      std::max(haze_pixels_.size(), static_cast<std::size_t>(t.haze_width) * t.haze_height),
+      glm::vec2(0.0f));
+  // The helper's first job now, so that its thread has run before the first spray does.
+  helper_.start([] {});
+  helper_.wait();
+}
+
 bool SprayPass::wanted(const FrameContext& frame) const {
   const sim::SprayImage* image = frame.scene.spray.get();
   return image && !image->points.empty();

@@ -35,6 +35,8 @@ class SprayPass final : public Pass {
   static constexpr int kHazeScale = 2;  // the haze's: the layer's over this
   static constexpr int kTile = 8;       // the layer's tiles, pixels
 
+  // Makes the targets and CPU buffers a view of this size will need.
+  void prepare(int view_width, int view_height);
   void set_smoothing(SpraySmoothing smoothing) { smoothing_ = smoothing; }
   SpraySmoothing smoothing() const { return smoothing_; }
   // Whether the CPU draws the parcels (llvmpipe) or the GPU; DOWNPOUR_SPRAY_SPLAT=cpu|gpu
