@@ -1,9 +1,6 @@
 // How the spray's liquid body depth is smoothed (seed 001, step 4): a renderer option. No GL.
 #pragma once
 
-#include <optional>
-#include <string_view>
-
 namespace downpour::render {
 
 enum class SpraySmoothing {
@@ -12,7 +9,5 @@ enum class SpraySmoothing {
   kNone,
 };
 const char* spray_smoothing_name(SpraySmoothing smoothing);
-// By name ("plane_fit", "bilateral", "none"); nullopt for another.
-std::optional<SpraySmoothing> spray_smoothing_from(std::string_view name);
 
 }  // namespace downpour::render

@@ -76,14 +76,6 @@ const char* spray_smoothing_name(SpraySmoothing smoothing) {
   return "?";
 }
 
-std::optional<SpraySmoothing> spray_smoothing_from(std::string_view name) {
-  for (SpraySmoothing s :
-       {SpraySmoothing::kPlaneFit, SpraySmoothing::kBilateral, SpraySmoothing::kNone}) {
-    if (name == spray_smoothing_name(s)) return s;
-  }
-  return std::nullopt;
-}
-
 SprayPass::SprayPass(SharedResources&)
     : depth_program_("spray_depth.vert", "spray_depth.frag"),
       plane_program_("spray_runs.vert", "spray_plane_fit.frag"),
