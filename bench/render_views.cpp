@@ -18,6 +18,9 @@
 //   frames with profiling off, wall and CPU time of all threads (and the same frame with a dry
 //   windshield, no blades), then each
 //   pass with profiling on, in a renderer of its own (a glFinish mid-frame slows llvmpipe).
+// --sun ALT AZ: the sun's altitude and azimuth (degrees) in place of the scene's; --cloud C its
+//   cloudiness [0, 1]; --fog F its fog density [0, 1]; --no-relief: without the relief's shadows
+//   (seed 002).
 // --wipe: a wipe as a picture sequence: the scene's weather and drive at t_s with the wipers off
 //   for t_s seconds, then one SINGLE wipe; COCKPIT, WINDSHIELD (and --dash) written before it,
 //   every sixth of the cycle through it, and after (wipe_K_*.png).
@@ -112,6 +115,9 @@ int main(int argc, char** argv) {
   double dry_after_s = -1.0;
   bool puddles = false;
   std::optional<testing::SprayDrive> spray_drive;
+  std::optional<std::array<double, 2>> sun;
+  double cloud = -1.0, fog = -1.0;
+  bool relief = true;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--windshield" && i + 1 < argc) {
@@ -134,6 +140,15 @@ int main(int argc, char** argv) {
       spray_drive->road_water_m = std::atof(argv[i + 2]) * 1e-3;
       spray_drive->seconds = std::atof(argv[i + 3]);
       i += 3;
+    } else if (arg == "--sun" && i + 2 < argc) {
+      sun = {std::atof(argv[i + 1]), std::atof(argv[i + 2])};
+      i += 2;
+    } else if (arg == "--cloud" && i + 1 < argc) {
+      cloud = std::atof(argv[++i]);
+    } else if (arg == "--fog" && i + 1 < argc) {
+      fog = std::atof(argv[++i]);
+    } else if (arg == "--no-relief") {
+      relief = false;
     } else if (arg == "--puddles") {
       puddles = true;
     } else if (arg == "--speed" && i + 1 < argc) {
@@ -149,7 +164,8 @@ int main(int argc, char** argv) {
                  "usage: downpour-render-views OUT_DIR [scene] [t_s] [width height] [rain_mm_h]"
                  " [--windshield N] [--blades A B] [--dash] [--measure FRAMES] [--wipe]"
                  " [--speed MPS] [--road-water FILM_MM [--puddles]] [--dry-after S]"
-                 " [--spray-drive GAP_M ROAD_MM SECONDS]\n");
+                 " [--spray-drive GAP_M ROAD_MM SECONDS] [--sun ALT AZ] [--cloud C] [--fog F]"
+                 " [--no-relief]\n");
     return 2;
   }
   const std::string out = positional[0];
@@ -162,6 +178,12 @@ int main(int argc, char** argv) {
   sim::Update update = scenario.at(t);
   if (positional.size() > 5 && update.weather)
     update.weather->rain_rate_mm_h = std::atof(positional[5].c_str());
+  if (sun && update.weather) {
+    update.weather->sun_altitude_deg = (*sun)[0];
+    update.weather->sun_azimuth_deg = (*sun)[1];
+  }
+  if (cloud >= 0.0 && update.weather) update.weather->cloudiness = cloud;
+  if (fog >= 0.0 && update.weather) update.weather->fog_density = fog;
   if (speed >= 0.0 && update.vehicle) {
     const double yaw = glm::radians(update.vehicle->rotation.yaw_deg);
     update.vehicle->velocity_mps = glm::dvec3(std::cos(yaw), std::sin(yaw), 0.0) * speed;
@@ -200,6 +222,9 @@ int main(int argc, char** argv) {
         scene.vehicle, road_film_mm,
         puddles ? testing::test_puddles() : std::vector<testing::HandPuddle>{});
   }
+  std::printf("car heading %.1f deg (world yaw), sun at %.1f deg high, %.1f deg yaw\n",
+              scene.vehicle.rotation.yaw_deg, scene.weather.sun_altitude_deg,
+              scene.weather.sun_azimuth_deg);
   std::printf("windshield: %zu metaballs, glass wet fraction %.3f\n",
               scene.windshield.metaballs.size(), scene.windshield.glass_wet_fraction);
 
@@ -229,6 +254,7 @@ int main(int argc, char** argv) {
   std::printf("renderer %s, created in %.0f ms\n", renderer->gl_renderer().c_str(),
               std::chrono::duration<double, std::milli>(t1 - t0).count());
   renderer->set_profiling(true);
+  renderer->set_relief_shadows(relief);
   for (const NamedView& v : views) {
     render::render_image(*renderer, v.spec, scene);  // the first draw compiles shader variants
     testing::RgbaImage image{width, height, render::render_image(*renderer, v.spec, scene)};

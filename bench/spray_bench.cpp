@@ -125,18 +125,11 @@ int main(int argc, char** argv) {
     // The spray's share of whole frames, plane fitting, no finish between passes.
     renderer->set_spray_smoothing(render::SpraySmoothing::kPlaneFit);
     renderer->set_profiling(false);
-    std::vector<double> added;
-    for (int i = 0; i < frames + kWarmUp; ++i) {
-      double ms[2];
-      for (int k = 0; k < 2; ++k) {
-        const auto t0 = std::chrono::steady_clock::now();
-        renderer->finish(renderer->render(*session, 0, spec, k == 0 ? wet : dry), pixels);
-        ms[k] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                    .count();
-      }
-      if (i >= kWarmUp) added.push_back(ms[0] - ms[1]);
-    }
-    row["spray_in_frame_ms"] = bench::median(added);
+    const bench::Added added = bench::added_to_frames(
+        frames, kWarmUp,
+        [&] { renderer->finish(renderer->render(*session, 0, spec, wet), pixels); },
+        [&] { renderer->finish(renderer->render(*session, 0, spec, dry), pixels); });
+    row["spray_in_frame_ms"] = added.added_ms;
     row["ceiling_ms"] = 6.0;
     out["views"].push_back(row);
     std::fprintf(stderr, "%s done\n", std::string(sim::view_name(view)).c_str());

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <chrono>
 #include <cstddef>
 #include <vector>
 
@@ -17,5 +18,34 @@ inline double percentile(std::vector<double> v, double p) {
 }
 
 inline double median(std::vector<double> v) { return percentile(std::move(v), 0.5); }
+
+// What one thing adds to whole frames: `frames` pairs of frames, one with it (with(), wall time)
+// and one without (without()), drawn in turn after `warm_up` pairs, so that a machine whose speed
+// drifts affects both alike. The median of the pairs' differences, and of the frames with it.
+struct Added {
+  double added_ms = 0.0;
+  double frame_ms = 0.0;
+};
+template <typename With, typename Without>
+Added added_to_frames(int frames, int warm_up, With&& with, Without&& without) {
+  std::vector<double> added, whole;
+  for (int i = 0; i < frames + warm_up; ++i) {
+    double ms[2];
+    for (int k = 0; k < 2; ++k) {
+      const auto t0 = std::chrono::steady_clock::now();
+      if (k == 0) {
+        with();
+      } else {
+        without();
+      }
+      ms[k] =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    }
+    if (i < warm_up) continue;
+    added.push_back(ms[0] - ms[1]);
+    whole.push_back(ms[0]);
+  }
+  return {median(added), median(whole)};
+}
 
 }  // namespace downpour::bench

@@ -24,12 +24,14 @@ vec4 fog_at(vec3 world_pos) {
 
 vec3 apply_fog(vec3 colour, vec4 fog) { return mix(fog.rgb, colour, fog.a); }
 
-// Diffuse light from the sun and the sky dome on a surface with normal n.
-vec3 diffuse_light(vec3 n) {
+// Diffuse light from the sun and the sky dome on a surface with normal n, the sun's share times
+// sun_lit (a shadow's 0 .. 1).
+vec3 diffuse_light_shadowed(vec3 n, float sun_lit) {
   float ndl = max(dot(n, frame.sun_dir.xyz), 0.0);
   float sky_view = 0.55 + 0.45 * n.z;
-  return frame.sun_radiance.rgb * ndl + frame.ambient.rgb * sky_view;
+  return frame.sun_radiance.rgb * (ndl * sun_lit) + frame.ambient.rgb * sky_view;
 }
+vec3 diffuse_light(vec3 n) { return diffuse_light_shadowed(n, 1.0); }
 
 // Schlick's Fresnel approximation.
 float schlick(float cos_theta, float r0) {

@@ -1,7 +1,8 @@
 // The road surface, included by its three programs (road_pass.cpp picks one per frame, since
 // llvmpipe pays for both sides of a branch on every pixel): road.frag without a mirror (a dry or
 // only wet road), road_mirror.frag with the road reflection (a film stands somewhere), and
-// road_ripples.frag with the reflection and the rings of drops in puddles (puddles in the rain).
+// road_ripples.frag with the reflection and the rings of drops in puddles (puddles in the rain);
+// each of them also with the relief's shadows under the sun (ROAD_RELIEF, the *_relief.frag ones).
 #include "common.glsl"
 in vec3 v_world;
 in vec3 v_normal;
@@ -13,7 +14,54 @@ uniform float u_lane_width;
 uniform int u_lanes_each_way;
 uniform float u_paved_half_width;
 
-const float kReliefTile = 1.5;  // metres of road per repeat of the relief texture
+const float kReliefTile = 1.5;  // metres of road per repeat of the relief texture (relief.hpp)
+const float kSettsTile = 1.0;   // the setts' (relief.hpp)
+const float kSettsWidth = 1.0;  // the band of setts from the pavement's edge out
+
+// The sunlight the asphalt's and the setts' relief keep past their shadows, over many texels
+// (relief.hpp's mean_lit): every program's where a pixel covers many texels; (1, 1) without them.
+uniform vec2 u_relief_mean_lit;
+
+#ifdef ROAD_RELIEF
+in vec2 v_curvature;       // k1, k2 (1/m, convex positive)
+in vec4 v_principal_dirs;  // v1, v2 in (u, v)
+uniform int u_horizon_directions;  // a relief's layers in horizon_tex
+uniform vec2 u_relief_depth_m;     // the asphalt's and the setts' heights for a texture's 1
+const float kHorizonDistanceRange = 0.5;  // m (relief.hpp)
+
+// Relief shadows on a curved surface (seed 002). l: the light in the texture's frame (x along u,
+// y along v, z the normal); tex: the relief's texture coordinates, layer0 its first layer in
+// horizon_tex; h the texel's height over the surface (m). 1 lit, 0 in the shadow.
+float relief_lit(vec3 l, vec2 tex, float layer0, float h) {
+  float along = length(l.xy);
+  float tan_theta = l.z / max(along, 1e-4);
+  // The two layers nearest the light's azimuth, linear between them.
+  float n = float(u_horizon_directions);
+  float f = atan(l.y, l.x) * (n / 6.2831853);
+  f = f < 0.0 ? f + n : f;
+  float k0 = min(floor(f), n - 1.0);
+  // Layer k0 holds azimuths k0 and k0 + 1, 8 bits each (relief.hpp's packed_layer).
+  vec4 maps = texture(horizon_tex, vec3(tex, layer0 + k0));
+  vec4 x = maps * 2.0 - 1.0;
+  vec2 tans = 4.0 * x.xz * abs(x.xz);
+  vec2 dists = maps.yw * maps.yw * kHorizonDistanceRange;
+  vec2 horizon = mix(vec2(tans.x, dists.x), vec2(tans.y, dists.y), f - k0);
+  // Eq. 1: the curvature along the light, k1 cos^2 + k2 sin^2 (squares only); convex parts alone.
+  vec2 v1 = v_principal_dirs.xy, v2 = v_principal_dirs.zw;
+  float c = dot(l.xy, v1), s = dot(l.xy, v2);
+  float k = (v_curvature.x * c * c / max(dot(v1, v1), 1e-6) +
+             v_curvature.y * s * s / max(dot(v2, v2), 1e-6)) / max(along * along, 1e-8);
+  k = max(k, 0.0);
+  // Eq. 2, the horizon point sunk by the curve; eq. 3, the surface's own rim below the tangent
+  // plane; the higher one holds (relief.hpp's corrected_tan_horizon).
+  float on_relief = horizon.r * (1.0 - k * h) - 0.5 * k * horizon.g;
+  float rim = 1.0 / (k * h + 1.0);
+  float on_surface = -sqrt(max(1.0 - rim * rim, 0.0)) / rim;
+  float tan_beta = max(on_relief, on_surface);
+  // A soft edge: the penumbra of the sun's half degree, and the maps' filtering.
+  return smoothstep(-0.015, 0.015, tan_theta - tan_beta);
+}
+#endif
 
 // Coverage of a painted stripe of half width hw centred at c, antialiased over one pixel.
 float stripe(float x, float c, float hw) {
@@ -138,10 +186,16 @@ void main() {
   t_along = normalize(t_along - n_geo * dot(n_geo, t_along) + 1e-6);
   vec3 t_lat = cross(n_geo, t_along);
 
+  // The pavement's asphalt, then a band of stone setts on the shoulder, then gravel and grass.
+  float verge = smoothstep(u_paved_half_width, u_paved_half_width + 0.05, a);
+  float setts_band = verge * step(a, u_paved_half_width + kSettsWidth);
   vec4 relief = texture(asphalt_tex, vec2(lat, s) / kReliefTile);
-  // Fade the relief with distance, where its texels get smaller than a pixel.
-  float detail = clamp(1.5 - length(fwidth(v_uv)) * 6.0, 0.0, 1.0);
-  vec3 rn = relief.rgb * 2.0 - 1.0;
+  vec4 setts = texture(setts_tex, vec2(lat, s) / kSettsTile);
+  // Fade the relief with distance, where its texels get smaller than a pixel (the setts', four
+  // times the size, later).
+  float px = length(fwidth(v_uv));
+  float detail = clamp(1.5 - px * mix(6.0, 1.5, setts_band), 0.0, 1.0);
+  vec3 rn = mix(relief.rgb, setts.rgb, setts_band) * 2.0 - 1.0;
   vec3 n = normalize(mix(n_geo, normalize(t_lat * rn.x + t_along * rn.y + n_geo * rn.z), detail));
 
   // Asphalt: light aggregate in dark binder; worn, darker wheel paths; patches.
@@ -162,11 +216,15 @@ void main() {
   albedo = mix(albedo, vec3(0.72, 0.72, 0.68), paint);
   n = normalize(mix(n, n_geo, paint * 0.8));  // paint fills the relief
 
-  // Beyond the pavement: gravel verge, then grass.
-  float verge = smoothstep(u_paved_half_width, u_paved_half_width + 0.05, a);
+  // Beyond the pavement: grey setts in sand (each stone its own shade), gravel, then grass.
+  float course = floor(s / kSettsTile * 10.0);  // relief.hpp: 8 setts across a tile, 10 courses
+  vec2 sett_id = vec2(floor(lat / kSettsTile * 8.0 + 0.5 * mod(course, 2.0)), course);
+  float stone = fract(sin(dot(sett_id, vec2(12.9898, 78.233))) * 43758.5453);
+  vec3 sett = vec3(0.2, 0.19, 0.18) * (0.75 + 0.5 * stone) * mix(0.55, 1.0, smoothstep(0.2, 0.5, setts.a));
   vec3 gravel = vec3(0.16, 0.15, 0.13) * (0.7 + 0.6 * h);
   vec3 grass = vec3(0.11, 0.16, 0.06) * (0.8 + 0.4 * patches);
-  albedo = mix(albedo, mix(gravel, grass, smoothstep(u_paved_half_width + 1.0, u_paved_half_width + 2.5, a)), verge);
+  vec3 beyond = mix(gravel, grass, smoothstep(u_paved_half_width + 1.6, u_paved_half_width + 2.8, a));
+  albedo = mix(albedo, mix(beyond, sett, setts_band), verge);
 
   // The water here (seed 003): the pores of the texture fill (wet: darker, the diffuse reduction
   // hd), a film stands over them (drench: smoother, a blurred mirror), then a puddle (a mirror
@@ -179,7 +237,25 @@ void main() {
   float pool = smoothstep(0.6, 2.0, water.y) * (1.0 - verge);
   albedo *= mix(1.0, 0.5, fill) * mix(1.0, 0.7, film);
   vec3 view = normalize(frame.camera_pos.xyz - v_world);
-  vec3 colour = albedo * diffuse_light(n);
+  // The relief's shadows under the sun, not where paint or a film of water fills the relief.
+  float on_setts = step(0.5, setts_band);
+  float shadow_shows = (1.0 - paint * (1.0 - on_setts)) * (1.0 - film);
+  float lit = mix(u_relief_mean_lit.x, u_relief_mean_lit.y, on_setts);
+#ifdef ROAD_RELIEF
+  vec3 l = vec3(dot(frame.sun_dir.xyz, t_lat), dot(frame.sun_dir.xyz, t_along),
+                dot(frame.sun_dir.xyz, n_geo));
+  vec2 relief_tex = vec2(lat, s) / mix(kReliefTile, kSettsTile, on_setts);
+  float relief_h = mix(relief.a * u_relief_depth_m.x, setts.a * u_relief_depth_m.y, on_setts);
+  // Shadows texel by texel where a pixel covers a few texels (the asphalt's up to 1-3 cm, the
+  // setts' 2-6 cm: within some metres of the camera); further off, their mean, not a pixel's
+  // pick of them. This program draws only the road near the camera (road_pass.cpp), since
+  // llvmpipe would run a branch around it on every pixel.
+  float resolved = 1.0 - smoothstep(mix(0.01, 0.02, on_setts), mix(0.03, 0.06, on_setts), px);
+  lit = mix(lit, relief_lit(l, relief_tex, on_setts * float(u_horizon_directions), relief_h),
+            resolved);
+#endif
+  float sun_lit = mix(1.0, lit, shadow_shows);
+  vec3 colour = albedo * diffuse_light_shadowed(n, sun_lit);
 
   vec3 n_refl = normalize(mix(mix(n, n_geo, 0.8 * film), n_geo, pool));
 #ifdef ROAD_RIPPLES

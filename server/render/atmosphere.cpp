@@ -33,17 +33,32 @@ Atmosphere atmosphere_from(const sim::Weather& w) {
   const glm::vec3 grey_zenith(0.52f, 0.55f, 0.58f);
   const glm::vec3 grey_horizon(0.66f, 0.68f, 0.70f);
   // A low sun warms the horizon.
-  const float low_sun = glm::smoothstep(25.0f, 0.0f, static_cast<float>(w.sun_altitude_deg)) * day;
+  const float alt_deg = static_cast<float>(w.sun_altitude_deg);
+  const float low_sun = glm::smoothstep(25.0f, 0.0f, alt_deg) * day;
   const glm::vec3 warm(1.0f, 0.72f, 0.5f);
-  a.sky_zenith = glm::mix(clear_zenith, grey_zenith, a.overcast) * level;
+  // Below 25 degrees the sky dims faster than the sun's beam (a clear sky gives a horizontal
+  // surface about as much light as a sun 5 degrees high gives one facing it, at noon a fifth), and
+  // the camera opens up to make up for part of the loss: the relief's grazing light and long
+  // shadows show at dusk.
+  const float sky_dim = 1.0f - 0.7f * low_sun;
+  const float exposure = 1.0f + 0.9f * low_sun;
+  a.sky_zenith = glm::mix(clear_zenith, grey_zenith, a.overcast) * level * sky_dim * exposure;
   a.sky_horizon =
       glm::mix(glm::mix(clear_horizon, clear_horizon * warm, low_sun), grey_horizon, a.overcast) *
-      level;
+      level * sky_dim * exposure;
 
-  const float sun_up = std::max(std::sin(alt), 0.0f);
-  const float direct = day * (1.0f - 0.9f * a.overcast) * rain_darkening;
-  a.sun_radiance = glm::mix(glm::vec3(1.0f, 0.95f, 0.88f), warm, low_sun) * 1.4f * direct *
-                   glm::smoothstep(0.0f, 0.1f, sun_up);
+  // The beam through the air: reddened along its path, by the air mass (Kasten and Young) beyond
+  // a 25-degree sun's; its disc sets over the horizon's last degree and a half.
+  const float above = glm::smoothstep(-0.8f, 0.8f, alt_deg);
+  const float airmass = [&] {
+    const float deg = std::max(alt_deg, 0.0f);
+    return 1.0f / (std::sin(glm::radians(deg)) + 0.50572f * std::pow(deg + 6.07995f, -1.6364f));
+  }();
+  const float airmass_25 = 2.35f;
+  const glm::vec3 extinction(0.03f, 0.07f, 0.15f);  // per air mass, relative: red passes
+  const glm::vec3 reddening = glm::exp(-extinction * std::max(airmass - airmass_25, 0.0f));
+  const float direct = (1.0f - 0.9f * a.overcast) * rain_darkening;
+  a.sun_radiance = glm::vec3(1.0f, 0.95f, 0.88f) * reddening * 1.4f * direct * above * exposure;
   a.ambient = glm::mix(a.sky_zenith, a.sky_horizon, 0.5f) * 0.9f;
 
   // Extinction: clear air sees kilometres; fog and rain bring the horizon in (the rain's from its

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 
 #include <glm/mat4x4.hpp>
 
@@ -14,6 +15,9 @@
 #include "server/sim/track.hpp"
 
 namespace downpour::render {
+namespace relief {
+struct RoadReliefs;
+}
 
 struct FrameContext {
   // The simulator's inputs for this frame: pose, weather, traffic, the time after the step. Its
@@ -65,6 +69,10 @@ struct SharedResources {
   Texture noise;    // make_noise, repeat
   Texture asphalt;  // make_asphalt_relief, repeat, mipmapped
   FullscreenTriangle fullscreen;
+  Texture setts;    // the shoulder's relief, repeat, mipmapped
+  Texture horizon;  // relief::road_reliefs' horizon maps, RG16F, a layer per azimuth and relief
+  int horizon_directions = 0;
+  std::shared_ptr<const relief::RoadReliefs> reliefs;
 };
 
 // Axis-aligned box against the view frustum's side and near planes.

@@ -108,6 +108,20 @@ Mesh::Mesh(const MeshData& data)
     glVertexArrayAttribFormat(vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
     glVertexArrayAttribBinding(vao, a, 0);
   }
+  if (!data.curvature.empty()) {
+    glCreateBuffers(1, ids);
+    curvature_ = Buffer(ids[0]);
+    glNamedBufferStorage(curvature_.id(), data.curvature.size() * sizeof(VertexCurvature),
+                         data.curvature.data(), 0);
+    glVertexArrayVertexBuffer(vao, 1, curvature_.id(), 0, sizeof(VertexCurvature));
+    const GLuint c_offsets[] = {offsetof(VertexCurvature, k1), offsetof(VertexCurvature, v1)};
+    const GLint c_sizes[] = {2, 4};
+    for (GLuint a = 0; a < 2; ++a) {
+      glEnableVertexArrayAttrib(vao, 3 + a);
+      glVertexArrayAttribFormat(vao, 3 + a, c_sizes[a], GL_FLOAT, GL_FALSE, c_offsets[a]);
+      glVertexArrayAttribBinding(vao, 3 + a, 1);
+    }
+  }
 }
 
 void Mesh::draw() const {

@@ -106,6 +106,7 @@ class Mesh {
   VertexArray vao_;
   Buffer vbo_;
   Buffer ibo_;
+  Buffer curvature_;
   GLsizei index_count_ = 0;
 };
 

@@ -15,8 +15,18 @@ struct MeshVertex {
   glm::vec2 uv;
 };
 
+// Principal curvatures and directions at a vertex (mesh_curvature.hpp), a second vertex stream
+// for the surfaces with relief shadows: attribute 3 (k1, k2), attribute 4 (v1, v2).
+struct VertexCurvature {
+  float k1 = 0.0f;  // 1/m, convex (falling away from the normal) positive; k1 >= k2
+  float k2 = 0.0f;
+  glm::vec2 v1{1.0f, 0.0f};  // the principal directions in the texture's (u, v) plane, unit
+  glm::vec2 v2{0.0f, 1.0f};
+};
+
 struct MeshData {
   std::vector<MeshVertex> vertices;
+  std::vector<VertexCurvature> curvature;  // empty, or one a vertex
   std::vector<std::uint32_t> indices;
   glm::vec3 bounds_min{1e30f};
   glm::vec3 bounds_max{-1e30f};

@@ -40,7 +40,7 @@ std::uint8_t to_byte(float v) {
 
 }  // namespace
 
-Image8 make_asphalt_relief(int size, std::uint32_t seed, float relief_depth) {
+std::vector<float> asphalt_height_unit(int size, std::uint32_t seed) {
   std::mt19937 rng(seed);
   std::vector<float> height(static_cast<std::size_t>(size * size), 0.0f);
   // Aggregate: rounded stones of a few sizes, packed at random, each a dome; the tallest wins.
@@ -66,7 +66,53 @@ Image8 make_asphalt_relief(int size, std::uint32_t seed, float relief_depth) {
   // Binder between the stones: low, slightly uneven.
   const std::vector<float> fine = value_noise(size, size / 8, rng);
   for (std::size_t i = 0; i < height.size(); ++i) height[i] = std::max(height[i], 0.12f * fine[i]);
+  return height;
+}
 
+std::vector<float> setts_height_unit(int size, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  // 8 courses of 10 setts across the tile, each course offset by half a stone from the last; a
+  // stone is a rounded block (its crown 0.7-1, worn flat in the middle, rounded to the joints),
+  // a little out of square; sand in the joints.
+  constexpr int kColumns = 8, kCourses = 10;
+  const float w = static_cast<float>(size) / kColumns, l = static_cast<float>(size) / kCourses;
+  std::vector<float> crown(kColumns * kCourses), tilt_x(kColumns * kCourses),
+      tilt_y(kColumns * kCourses), shrink(kColumns * kCourses);
+  for (std::size_t k = 0; k < crown.size(); ++k) {
+    crown[k] = 0.7f + 0.3f * u(rng);
+    tilt_x[k] = (u(rng) - 0.5f) * 0.3f;
+    tilt_y[k] = (u(rng) - 0.5f) * 0.3f;
+    shrink[k] = 0.8f + 0.12f * u(rng);
+  }
+  const std::vector<float> sand = value_noise(size, size / 8, rng);
+  std::vector<float> height(static_cast<std::size_t>(size * size));
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      const float fy = (static_cast<float>(y) + 0.5f) / l;
+      const int course = static_cast<int>(fy);
+      const float fx = (static_cast<float>(x) + 0.5f) / w + 0.5f * static_cast<float>(course & 1);
+      const int column = static_cast<int>(fx) % kColumns;
+      const std::size_t k = static_cast<std::size_t>(course % kCourses * kColumns + column);
+      // Distance to the stone's edge, as a fraction of its half size (0 at its centre).
+      const float ex = std::abs(fx - std::floor(fx) - 0.5f) * 2.0f / shrink[k];
+      const float ey = std::abs(fy - std::floor(fy) - 0.5f) * 2.0f / shrink[k];
+      const float e = std::max(ex, ey);
+      float h = 0.08f + 0.1f * sand[static_cast<std::size_t>(y * size + x)];
+      if (e < 1.0f) {
+        const float round =
+            std::sqrt(std::max(0.0f, 1.0f - std::pow(std::max(e - 0.35f, 0.0f) / 0.65f, 2.0f)));
+        const float top = crown[k] * round + tilt_x[k] * (fx - std::floor(fx) - 0.5f) +
+                          tilt_y[k] * (fy - std::floor(fy) - 0.5f);
+        h = std::max(h, top);
+      }
+      height[static_cast<std::size_t>(y * size + x)] = std::clamp(h, 0.0f, 1.0f);
+    }
+  }
+  return height;
+}
+
+Image8 relief_image(const std::vector<float>& height, int size, float relief_depth) {
   Image8 img{size, size, std::vector<std::uint8_t>(static_cast<std::size_t>(size * size * 4))};
   auto h = [&](int x, int y) { return height[((y + size) % size) * size + ((x + size) % size)]; };
   for (int y = 0; y < size; ++y) {
@@ -82,6 +128,10 @@ Image8 make_asphalt_relief(int size, std::uint32_t seed, float relief_depth) {
     }
   }
   return img;
+}
+
+Image8 make_asphalt_relief(int size, std::uint32_t seed, float relief_depth) {
+  return relief_image(asphalt_height_unit(size, seed), size, relief_depth);
 }
 
 Image8 make_noise(int size, std::uint32_t seed) {

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <tuple>
 
@@ -28,6 +29,7 @@
 #include "server/render/passes/vehicle_pass.hpp"
 #include "server/render/passes/windshield_pass.hpp"
 #include "server/render/procedural_textures.hpp"
+#include "server/render/relief.hpp"
 #include "server/render/shader_interface.hpp"
 #include "server/sim/pose.hpp"
 
@@ -52,6 +54,35 @@ Texture upload_repeating(const Image8& image, bool mipmaps) {
   glTextureParameteri(t.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
   glTextureParameteri(t.id(), GL_TEXTURE_WRAP_T, GL_REPEAT);
   return t;
+}
+
+// The relief shadows' azimuths (seed 002: 16 or 32).
+constexpr int kHorizonDirections = 32;
+
+// The setts' relief and both reliefs' horizon maps: one array, the asphalt's layers first, packed
+// (relief::packed_layer).
+void upload_reliefs(SharedResources& shared, const std::shared_ptr<const relief::RoadReliefs>& r) {
+  shared.setts = upload_repeating(relief_image(setts_height_unit(r->setts.size, 3), r->setts.size,
+                                               relief::kSettsDepthM / r->setts.texel_m),
+                                  true);
+  const relief::HorizonMaps* maps[] = {&r->asphalt_horizon, &r->setts_horizon};
+  const int size = maps[0]->size, n = maps[0]->directions;
+  shared.horizon_directions = n;
+  shared.reliefs = r;
+  shared.horizon = make_texture_2d_array(GL_RGBA8, size, size, 2 * n);
+  for (int m = 0; m < 2; ++m) {
+    if (maps[m]->size != size || maps[m]->directions != n) {
+      throw std::logic_error("the reliefs' horizon maps differ in size");
+    }
+    for (int k = 0; k < n; ++k) {
+      glTextureSubImage3D(shared.horizon.id(), 0, 0, 0, m * n + k, size, size, 1, GL_RGBA,
+                          GL_UNSIGNED_BYTE, relief::packed_layer(*maps[m], k).data());
+    }
+  }
+  glTextureParameteri(shared.horizon.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTextureParameteri(shared.horizon.id(), GL_TEXTURE_WRAP_T, GL_REPEAT);
+  glTextureParameteri(shared.horizon.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(shared.horizon.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
 }
 
 Framebuffer framebuffer_with(GLuint colour, GLuint depth) {
@@ -197,6 +228,7 @@ struct Renderer::Impl {
   std::unique_ptr<RenderSession> image_session;  // render_image's
   RainPass* rain = nullptr;                      // one of passes
   SprayPass* spray = nullptr;                    // likewise
+  RoadPass* road = nullptr;                      // likewise
   std::uint32_t rain_streaks = 0;                // drawn by the last render()
   // What the road reflection draws, mirrored (passes of the views), each clipped to this far above
   // the mirror's plane; and the views that read it.
@@ -537,9 +569,13 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
 
   impl->shared = std::make_unique<SharedResources>(
       SharedResources{sim::Track::built_in(), upload_repeating(make_noise(256, 1), true),
-                      upload_repeating(make_asphalt_relief(512, 2), true), FullscreenTriangle()});
+                      upload_repeating(make_asphalt_relief(512, 2), true), FullscreenTriangle(),
+                      Texture(), Texture(), 0, nullptr});
+  upload_reliefs(*impl->shared, relief::road_reliefs(kHorizonDirections));
   glBindTextureUnit(texture_unit::kNoise, impl->shared->noise.id());
   glBindTextureUnit(texture_unit::kAsphalt, impl->shared->asphalt.id());
+  glBindTextureUnit(texture_unit::kSetts, impl->shared->setts.id());
+  glBindTextureUnit(texture_unit::kHorizon, impl->shared->horizon.id());
   GLuint ubo = 0;
   glCreateBuffers(1, &ubo);
   impl->frame_ubo = Buffer(ubo);
@@ -550,7 +586,8 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   // so what is hidden costs little, and the sky shades only the pixels left empty.
   Pass* cockpit = impl->add<CockpitPass>();
   Pass* vehicles = impl->add<VehiclePass>();
-  Pass* road = impl->add<RoadPass>();
+  RoadPass* road = impl->add<RoadPass>();
+  impl->road = road;
   Pass* terrain = impl->add<TerrainPass>();
   Pass* sky = impl->add<SkyPass>();
   RainPass* rain = impl->add<RainPass>();
@@ -598,6 +635,8 @@ void Renderer::set_spray_smoothing(SpraySmoothing smoothing) {
   impl_->spray->set_smoothing(smoothing);
 }
 SpraySmoothing Renderer::spray_smoothing() const { return impl_->spray->smoothing(); }
+void Renderer::set_relief_shadows(bool on) { impl_->road->set_relief_shadows(on); }
+bool Renderer::last_drew_relief() const { return impl_->road->drew_relief(); }
 void Renderer::set_spray_cpu_splat(bool cpu) { impl_->spray->set_cpu_splat(cpu); }
 bool Renderer::spray_cpu_splat() const { return impl_->spray->cpu_splat(); }
 std::vector<float> Renderer::smooth_spray_body(int width, int height, float tan_x, float tan_y,

@@ -76,6 +76,10 @@ class Renderer {
   // Seed 001's smoothing of the spray's body (RendererOptions::spray_smoothing at start).
   void set_spray_smoothing(SpraySmoothing smoothing);
   SpraySmoothing spray_smoothing() const;
+  // The relief's shadows on the road under the sun (seed 002), on by default; and whether the last
+  // frame drew them (not where the direct sunlight is too faint).
+  void set_relief_shadows(bool on);
+  bool last_drew_relief() const;
   // Whether the CPU draws the spray's parcels (llvmpipe's choice) or the GPU.
   void set_spray_cpu_splat(bool cpu);
   bool spray_cpu_splat() const;

@@ -6,6 +6,8 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "server/render/mesh_curvature.hpp"
+
 namespace downpour::render {
 namespace {
 
@@ -31,15 +33,14 @@ namespace {
 // The road in chunks of chunk_length_m with cross-sections every step_m.
 std::vector<MeshData> road_chunks(const sim::Track& track, double chunk_length_m, double step) {
   const double half = track.paved_half_width();
-  // Lateral stations of the cross-section, left positive.
-  const std::vector<double> stations = {
-      -half - kVerge,
-      -half,
-      -track.cross_section().lanes_each_way * track.cross_section().lane_width_m,
-      0.0,
-      track.cross_section().lanes_each_way * track.cross_section().lane_width_m,
-      half,
-      half + kVerge};
+  // Lateral stations of the cross-section, left positive: the verge's every metre, so that its
+  // rounded fall (below) is a curve the mesh's curvature can be taken from.
+  const double lanes = track.cross_section().lanes_each_way * track.cross_section().lane_width_m;
+  std::vector<double> stations = {-lanes, 0.0, lanes};
+  for (double t = 0.0; t <= kVerge + 1e-9; t += kVerge / 4.0) {
+    stations.insert(stations.begin(), -half - t);
+    stations.push_back(half + t);
+  }
   std::vector<MeshData> chunks;
   const int rows_total = static_cast<int>(std::ceil(track.length() / step));
   const int rows_per_chunk = std::max(1, static_cast<int>(chunk_length_m / step));
@@ -51,14 +52,15 @@ std::vector<MeshData> road_chunks(const sim::Track& track, double chunk_length_m
       const sim::TrackFrame f = track.at(s);
       for (double lat : stations) {
         const double clamped = std::clamp(lat, -half, half);
-        double z = track.surface_height(s, clamped);
-        if (std::abs(lat) > half) z -= kVergeDrop * (std::abs(lat) - half) / kVerge;
+        const double t = std::max(std::abs(lat) - half, 0.0) / kVerge;
+        // The verge rounds over from the pavement's edge: level there, falling ever faster.
+        const double z = track.surface_height(s, clamped) - kVergeDrop * t * t;
         const glm::dvec2 xy = glm::dvec2(f.position) + f.left * lat;
         // Normal from the cross-slope and the grade.
         const double cross = std::abs(lat) < 1e-9
                                  ? 0.0
                                  : (std::abs(lat) <= half ? track.cross_section().crown_slope
-                                                          : kVergeDrop / kVerge) *
+                                                          : 2.0 * kVergeDrop * t / kVerge) *
                                        (lat > 0 ? -1.0 : 1.0);
         const glm::dvec3 forward(std::cos(f.heading_rad), std::sin(f.heading_rad), f.grade);
         const glm::dvec3 side(f.left.x, f.left.y, cross);
@@ -73,6 +75,9 @@ std::vector<MeshData> road_chunks(const sim::Track& track, double chunk_length_m
         m.add_quad(i, i + 1, i + 1 + cols, i + cols);
       }
     }
+    // For the relief shadows' correction (seed 002): the crests of the road's profile, the
+    // rounded verge.
+    m.curvature = vertex_curvatures(m);
     chunks.push_back(std::move(m));
   }
   return chunks;

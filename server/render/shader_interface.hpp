@@ -10,33 +10,37 @@
 namespace downpour::render {
 
 // Texture units: X(C++ name, unit, GLSL sampler type, GLSL name, what it holds).
-#define DOWNPOUR_TEXTURE_UNITS(X)                                                                 \
-  X(kNoise, 1, sampler2D, noise_tex, "value noise, 4 frequencies in rgba, repeating")             \
-  X(kAsphalt, 2, sampler2D, asphalt_tex, "asphalt relief: rgb normal, a height (seed 003, 3.1)")  \
-  X(kGlassWater, 3, sampler2D, glass_water_tex,                                                   \
-    "the session's glass water map: normal uv, compressed height, coverage")                      \
-  X(kSceneBlur, 4, sampler2D, scene_blur_tex,                                                     \
-    "the scene outside the glass, an eighth of the view, mirrored repeat")                        \
-  X(kViewColour, 5, sampler2D, view_colour_tex, "the view's colour so far")                       \
-  X(kViewDepth, 6, sampler2D, view_depth_tex, "the view's depth so far (reversed-Z)")             \
-  X(kGlassLayer, 7, sampler2D, glass_layer_tex,                                                   \
-    "the water on the glass over the scene, reduced size, premultiplied")                         \
-  X(kRainLayer, 8, sampler2D, rain_layer_tex,                                                     \
-    "the rain streaks, reduced size, premultiplied (rain_layer.hpp)")                             \
-  X(kRoadWater, 9, sampler2DArray, road_water_tex,                                                \
-    "the road's water in rings around the car, a layer per ring: r water, g standing water (mm)") \
-  X(kReflection, 10, sampler2D, reflection_tex,                                                   \
-    "the scene mirrored in the road's plane, reduced size, mipmapped (display-encoded)")          \
-  X(kReflectionDepth, 11, sampler2D, reflection_depth_tex, "its depth (reversed-Z)")              \
-  X(kSprayDepth, 12, sampler2D, spray_depth_tex,                                                  \
-    "the spray's depth maps (seed 001): r body front, g body back, b spray front, a spray "       \
-    "back; distances (m), backs negated")                                                         \
-  X(kSpraySmooth, 13, sampler2D, spray_smooth_tex,                                                \
-    "the body's front distance (r), being smoothed or smoothed")                                  \
-  X(kSprayLayer, 14, sampler2D, spray_layer_tex,                                                  \
-    "the spray over the scene, reduced size, premultiplied")                                      \
-  X(kSprayHaze, 15, sampler2D, spray_haze_tex,                                                    \
-    "the spray's haze, a quarter of the view: r optical depth, g that times distance (m)")
+#define DOWNPOUR_TEXTURE_UNITS(X)                                                                  \
+  X(kNoise, 1, sampler2D, noise_tex, "value noise, 4 frequencies in rgba, repeating")              \
+  X(kAsphalt, 2, sampler2D, asphalt_tex, "asphalt relief: rgb normal, a height (seed 003, 3.1)")   \
+  X(kGlassWater, 3, sampler2D, glass_water_tex,                                                    \
+    "the session's glass water map: normal uv, compressed height, coverage")                       \
+  X(kSceneBlur, 4, sampler2D, scene_blur_tex,                                                      \
+    "the scene outside the glass, an eighth of the view, mirrored repeat")                         \
+  X(kViewColour, 5, sampler2D, view_colour_tex, "the view's colour so far")                        \
+  X(kViewDepth, 6, sampler2D, view_depth_tex, "the view's depth so far (reversed-Z)")              \
+  X(kGlassLayer, 7, sampler2D, glass_layer_tex,                                                    \
+    "the water on the glass over the scene, reduced size, premultiplied")                          \
+  X(kRainLayer, 8, sampler2D, rain_layer_tex,                                                      \
+    "the rain streaks, reduced size, premultiplied (rain_layer.hpp)")                              \
+  X(kRoadWater, 9, sampler2DArray, road_water_tex,                                                 \
+    "the road's water in rings around the car, a layer per ring: r water, g standing water (mm)")  \
+  X(kReflection, 10, sampler2D, reflection_tex,                                                    \
+    "the scene mirrored in the road's plane, reduced size, mipmapped (display-encoded)")           \
+  X(kReflectionDepth, 11, sampler2D, reflection_depth_tex, "its depth (reversed-Z)")               \
+  X(kSprayDepth, 12, sampler2D, spray_depth_tex,                                                   \
+    "the spray's depth maps (seed 001): r body front, g body back, b spray front, a spray "        \
+    "back; distances (m), backs negated")                                                          \
+  X(kSpraySmooth, 13, sampler2D, spray_smooth_tex,                                                 \
+    "the body's front distance (r), being smoothed or smoothed")                                   \
+  X(kSprayLayer, 14, sampler2D, spray_layer_tex,                                                   \
+    "the spray over the scene, reduced size, premultiplied")                                       \
+  X(kSprayHaze, 15, sampler2D, spray_haze_tex,                                                     \
+    "the spray's haze, a quarter of the view: r optical depth, g that times distance (m)")         \
+  X(kSetts, 16, sampler2D, setts_tex, "the shoulder's stone setts: rgb normal, a height")          \
+  X(kHorizon, 17, sampler2DArray, horizon_tex,                                                     \
+    "the reliefs' horizon maps (seed 002), a layer per azimuth k, the asphalt's then the setts': " \
+    "rg tan(beta) and distance at k, ba at k + 1, encoded (relief.hpp)")
 
 // The per-frame uniform block: X(GLSL type, name, comment). Every field is a vec4 or a mat4, so
 // the C++ struct below has the std140 layout as it is.

@@ -1,5 +1,11 @@
 #include "server/render/passes/road_pass.hpp"
 
+#include <algorithm>
+#include <cmath>
+
+#include <glm/trigonometric.hpp>
+
+#include "server/render/relief.hpp"
 #include "server/render/scene_geometry.hpp"
 
 namespace downpour::render {
@@ -8,14 +14,24 @@ namespace {
 
 // Standing water (mm) from which road_surface.glsl draws a puddle, and so ripples.
 constexpr float kPuddleFromMm = 0.6f;
+// Direct sunlight below which the relief's shadows are not drawn: the sun's radiance at the
+// ground (frame.sun_radiance's brightest channel: 1.4 under a clear high sun, 0.14 through a
+// full overcast, where the sky's light alone shows).
+constexpr float kReliefSunFrom = 0.1f;
+// The pixel size (m) beyond which the setts' shadows are their mean (road_surface.glsl).
+constexpr float kSettsResolvedToM = 0.06f;
 
 }  // namespace
 
 RoadPass::RoadPass(SharedResources& shared)
-    : programs_{ShaderProgram("mesh.vert", "road.frag"),
-                ShaderProgram("mesh.vert", "road_mirror.frag"),
-                ShaderProgram("mesh.vert", "road_ripples.frag")},
-      chunks_(build_road_chunks(shared.track), {150.0f, 500.0f}) {
+    : programs_{ShaderProgram("road.vert", "road.frag"),
+                ShaderProgram("road.vert", "road_mirror.frag"),
+                ShaderProgram("road.vert", "road_ripples.frag"),
+                ShaderProgram("road.vert", "road_relief.frag"),
+                ShaderProgram("road.vert", "road_mirror_relief.frag"),
+                ShaderProgram("road.vert", "road_ripples_relief.frag")},
+      chunks_(build_road_chunks(shared.track), {150.0f, 500.0f}),
+      reliefs_(shared.reliefs) {
   const sim::CrossSection& section = shared.track.cross_section();
   for (const ShaderProgram& program : programs_) {
     program.uniform("u_model").set(glm::mat4(1.0f));
@@ -23,6 +39,25 @@ RoadPass::RoadPass(SharedResources& shared)
     program.uniform("u_lanes_each_way").set(section.lanes_each_way);
     program.uniform("u_paved_half_width").set(static_cast<float>(shared.track.paved_half_width()));
   }
+  for (std::size_t p = 3; p < programs_.size(); ++p) {
+    programs_[p].uniform("u_horizon_directions").set(shared.horizon_directions);
+    programs_[p]
+        .uniform("u_relief_depth_m")
+        .set(glm::vec2(relief::kAsphaltDepthM, relief::kSettsDepthM));
+  }
+}
+
+float RoadPass::relief_reach_m(const FrameContext& frame) {
+  // A pixel's footprint on the road, d away from a camera h over it, for a pixel angle a, is
+  // d a sqrt(1 + d^2 / h^2) along the view: about d^2 a / h where it is long. The setts' shadows
+  // fade out from 6 cm (road_surface.glsl), reached at d = sqrt(0.06 h / a); a tenth further for
+  // safety (the shader's footprint, the sum of two derivatives, is the longer one, and the split
+  // measures d from the camera, not along the ground: both only bring the fade nearer).
+  const float pixel_rad = 2.0f * std::tan(glm::radians(frame.camera.fov_y_deg) * 0.5f) /
+                          static_cast<float>(std::max(frame.spec.height, 1));
+  const float height = std::max(
+      frame.camera.position.z - static_cast<float>(frame.scene.vehicle.position_m.z), 0.5f);
+  return 1.1f * std::sqrt(kSettsResolvedToM * height / pixel_rad);
 }
 
 void RoadPass::execute(const FrameContext& frame, const FrameResources& resources) {
@@ -32,8 +67,33 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
   const sim::RoadWaterImage* water = frame.scene.road_water.get();
   const bool ripples = mirror && frame.scene.weather.rain_rate_mm_h > 0.0 && water &&
                        water->max_standing_mm > kPuddleFromMm;
-  programs_[ripples ? 2 : mirror ? 1 : 0].use();
-  chunks_.draw_visible(frame.camera.projection * frame.camera.view, frame.camera.position);
+  const glm::vec3& sun = frame.atmosphere.sun_radiance;
+  drew_relief_ = relief_ && std::max({sun.r, sun.g, sun.b}) > kReliefSunFrom;
+  const ShaderProgram& plain = programs_[ripples ? 2 : mirror ? 1 : 0];
+  const glm::mat4 view_proj = frame.camera.projection * frame.camera.view;
+  glEnable(GL_CLIP_DISTANCE1);
+  // Relief shadows: the near road with them, the rest without (llvmpipe would fetch the horizon
+  // maps on every pixel of one draw, even where a branch skips them). Where a pixel covers many
+  // of the relief's texels the shader takes their shadows' mean; the near part ends where that
+  // holds everywhere.
+  float reach = 0.0f;
+  glm::vec2 mean_lit(1.0f);
+  if (drew_relief_) {
+    reach = relief_reach_m(frame);
+    const float elevation = std::asin(std::clamp(frame.atmosphere.sun_direction.z, 0.0f, 1.0f));
+    mean_lit = {reliefs_->asphalt_horizon.mean_lit(elevation),
+                reliefs_->setts_horizon.mean_lit(elevation)};
+    const ShaderProgram& relief = programs_[(ripples ? 2 : mirror ? 1 : 0) + 3];
+    relief.use();
+    relief.uniform("u_relief_mean_lit").set(mean_lit);
+    relief.uniform("u_near_split").set(glm::vec2(reach, 1.0f));
+    chunks_.draw_visible(view_proj, frame.camera.position);
+  }
+  plain.use();
+  plain.uniform("u_relief_mean_lit").set(mean_lit);
+  plain.uniform("u_near_split").set(glm::vec2(reach, -1.0f));
+  chunks_.draw_visible(view_proj, frame.camera.position);
+  glDisable(GL_CLIP_DISTANCE1);
 }
 
 }  // namespace downpour::render

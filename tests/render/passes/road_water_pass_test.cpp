@@ -68,14 +68,16 @@ class RoadWaterPassTest : public testing::RenderTest {
 TEST_F(RoadWaterPassTest, RoadDarkensFromDryToWet) {
   // The road behind the car in the chase view, in the car's lane, seen steeply (about 35 degrees
   // down): the diffuse part falls as the texture fills and a film stands on it, and the film's
-  // mirror adds little at this angle. Light rain under broken cloud: the road, not the haze.
+  // mirror adds little at this angle. Light rain under broken cloud: the road, not the haze. (The
+  // dry road's relief casts shadows under the 30-degree sun, about 5% of its sunlight, which the
+  // film fills: the bound was 0.85 before the shadows.)
   const auto road = [&](double film_mm) {
     const RgbaImage image = render(sim::View::kRoad, scene(1.0, film_mm, false, 0.3));
     return testing::mean_luma(image, kWidth * 28 / 100, kHeight * 9 / 10, kWidth * 45 / 100,
                               kHeight);
   };
   const double dry = road(0.0), wet = road(0.3);
-  EXPECT_LT(wet, dry * 0.85) << "dry " << dry << ", wet " << wet;
+  EXPECT_LT(wet, dry * 0.87) << "dry " << dry << ", wet " << wet;
 }
 
 TEST_F(RoadWaterPassTest, TailLightsAreMirroredBelowTheCarOnAWetRoad) {

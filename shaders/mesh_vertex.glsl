@@ -1,0 +1,38 @@
+// A static mesh in world space (mesh.vert); with MESH_CURVATURE, its vertices' principal
+// curvatures and directions passed on for the relief shadows (road.vert).
+#include "common.glsl"
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec2 a_uv;
+uniform mat4 u_model;
+out vec3 v_world;
+out vec3 v_normal;
+out vec2 v_uv;
+out vec4 v_fog;
+#ifdef MESH_CURVATURE
+layout(location = 3) in vec2 a_curvature;      // k1, k2 (1/m, convex positive)
+layout(location = 4) in vec4 a_principal_dirs;  // v1, v2 in (u, v)
+out vec2 v_curvature;
+out vec4 v_principal_dirs;
+// The road drawn in two parts, near and far of x metres from the camera: y = 1 keeps the near
+// part, -1 the far (the same distance negated, so that the parts meet without a crack).
+uniform vec2 u_near_split;
+#endif
+void main() {
+  vec4 world = u_model * vec4(a_position, 1.0);
+  v_world = world.xyz;
+  v_normal = mat3(u_model) * a_normal;
+  v_uv = a_uv;
+  v_fog = fog_at(world.xyz);
+#ifdef MESH_CURVATURE
+  v_curvature = a_curvature;
+  v_principal_dirs = a_principal_dirs;
+#endif
+  gl_Position = frame.view_proj * world;
+  // The road reflection keeps what is above the road; other frames' plane keeps everything (a
+  // distance written is a distance used on llvmpipe, enabled or not).
+  gl_ClipDistance[0] = dot(frame.clip_plane.xyz, world.xyz) + frame.clip_plane.w;
+#ifdef MESH_CURVATURE
+  gl_ClipDistance[1] = u_near_split.y * (u_near_split.x - distance(world.xyz, frame.camera_pos.xyz));
+#endif
+}

@@ -1,0 +1,6 @@
+#version 450
+// The road with the road reflection, ripples in its puddles and relief shadows (road_surface.glsl).
+#define ROAD_MIRROR
+#define ROAD_RIPPLES
+#define ROAD_RELIEF
+#include "road_surface.glsl"
