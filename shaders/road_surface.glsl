@@ -247,10 +247,10 @@ void main() {
   vec2 relief_tex = vec2(lat, s) / mix(kReliefTile, kSettsTile, on_setts);
   float relief_h = mix(relief.a * u_relief_depth_m.x, setts.a * u_relief_depth_m.y, on_setts);
   // Shadows texel by texel where a pixel covers a few texels (the asphalt's up to 1-3 cm, the
-  // setts' 2-6 cm: within some metres of the camera); further off, their mean, not a pixel's
+  // setts' 1.5-4 cm: within some metres of the camera); further off, their mean, not a pixel's
   // pick of them. This program draws only the road near the camera (road_pass.cpp), since
   // llvmpipe would run a branch around it on every pixel.
-  float resolved = 1.0 - smoothstep(mix(0.01, 0.02, on_setts), mix(0.03, 0.06, on_setts), px);
+  float resolved = 1.0 - smoothstep(mix(0.01, 0.015, on_setts), mix(0.03, 0.04, on_setts), px);
   lit = mix(lit, relief_lit(l, relief_tex, on_setts * float(u_horizon_directions), relief_h),
             resolved);
 #endif

@@ -19,7 +19,7 @@ constexpr float kPuddleFromMm = 0.6f;
 // full overcast, where the sky's light alone shows).
 constexpr float kReliefSunFrom = 0.1f;
 // The pixel size (m) beyond which the setts' shadows are their mean (road_surface.glsl).
-constexpr float kSettsResolvedToM = 0.06f;
+constexpr float kSettsResolvedToM = 0.04f;
 
 }  // namespace
 
@@ -50,7 +50,7 @@ RoadPass::RoadPass(SharedResources& shared)
 float RoadPass::relief_reach_m(const FrameContext& frame) {
   // A pixel's footprint on the road, d away from a camera h over it, for a pixel angle a, is
   // d a sqrt(1 + d^2 / h^2) along the view: about d^2 a / h where it is long. The setts' shadows
-  // fade out from 6 cm (road_surface.glsl), reached at d = sqrt(0.06 h / a); a tenth further for
+  // fade out from 4 cm (road_surface.glsl), reached at d = sqrt(0.04 h / a); a tenth further for
   // safety (the shader's footprint, the sum of two derivatives, is the longer one, and the split
   // measures d from the camera, not along the ground: both only bring the fade nearer).
   const float pixel_rad = 2.0f * std::tan(glm::radians(frame.camera.fov_y_deg) * 0.5f) /
