@@ -54,6 +54,35 @@ grpc::Status to_vehicle(const v1::VehicleState& in, const std::string& field,
   DP_RETURN_IF_ERROR(to_rotation(in.rotation(), field + ".rotation", &out->rotation));
   DP_RETURN_IF_ERROR(
       to_vec3(in.velocity_mps(), 150.0, field + ".velocity_mps", &out->velocity_mps));
+  out->lights.reset();
+  if (in.has_lights()) {
+    const v1::VehicleLights& l = in.lights();
+    sim::VehicleLights lights;
+    switch (l.headlights()) {
+      case v1::HEADLIGHTS_AUTO:
+        lights.headlights = sim::Headlights::kAuto;
+        break;
+      case v1::HEADLIGHTS_OFF:
+        lights.headlights = sim::Headlights::kOff;
+        break;
+      case v1::HEADLIGHTS_LOW:
+        lights.headlights = sim::Headlights::kLow;
+        break;
+      case v1::HEADLIGHTS_HIGH:
+        lights.headlights = sim::Headlights::kHigh;
+        break;
+      default:
+        return invalid(field + ".lights.headlights",
+                       "must be one of HEADLIGHTS_AUTO, HEADLIGHTS_OFF, HEADLIGHTS_LOW, "
+                       "HEADLIGHTS_HIGH, got " +
+                           std::to_string(l.headlights()));
+    }
+    lights.brake = l.brake();
+    lights.left_indicator = l.left_indicator();
+    lights.right_indicator = l.right_indicator();
+    lights.reverse = l.reverse();
+    out->lights = lights;
+  }
   return grpc::Status::OK;
 }
 

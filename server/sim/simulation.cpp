@@ -77,6 +77,29 @@ void Simulation::apply(const Update& update) {
   if (update.wipers) state_.wipers = *update.wipers;
   if (update.weather) state_.weather = *update.weather;
   if (update.traffic) state_.traffic = *update.traffic;
+  resolve_lights(update.vehicle.has_value(), update.traffic.has_value());
+}
+
+void Simulation::resolve_lights(bool vehicle_moved, bool traffic_moved) {
+  if (vehicle_moved) ego_motion_.observe(state_.vehicle, state_.sim_time_s);
+  state_.ego_lights =
+      sim::resolve_lights(state_.vehicle.lights, state_.weather, ego_motion_.braking);
+  if (traffic_moved) {
+    std::unordered_map<std::uint32_t, VehicleMotion> seen;
+    for (const TrafficVehicle& t : state_.traffic) {
+      auto it = traffic_motion_.find(t.id);
+      VehicleMotion m = it != traffic_motion_.end() ? it->second : VehicleMotion{};
+      m.observe(t.state, state_.sim_time_s);
+      seen[t.id] = m;
+    }
+    traffic_motion_ = std::move(seen);
+  }
+  state_.traffic_lights.clear();
+  for (const TrafficVehicle& t : state_.traffic) {
+    const auto it = traffic_motion_.find(t.id);
+    state_.traffic_lights.push_back(sim::resolve_lights(
+        t.state.lights, state_.weather, it != traffic_motion_.end() && it->second.braking));
+  }
 }
 
 void Simulation::advance(double dt_s) {
@@ -118,6 +141,8 @@ SceneState Simulation::inputs_after(double dt_s) const {
   inputs.wipers = state_.wipers;
   inputs.weather = state_.weather;
   inputs.traffic = state_.traffic;
+  inputs.ego_lights = state_.ego_lights;
+  inputs.traffic_lights = state_.traffic_lights;
   inputs.glass = state_.glass;
   // The road's water as the last step left it (it changes over seconds; the step may be running
   // while the road is drawn).

@@ -5,9 +5,11 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include "server/sim/glass_water_map.hpp"
+#include "server/sim/lights.hpp"
 #include "server/sim/rain_field.hpp"
 #include "server/sim/road_water.hpp"
 #include "server/sim/spray.hpp"
@@ -61,6 +63,10 @@ struct SceneState {
   // The spray's parcels, relative to the ego car's reference point when taken; replaced after each
   // advance() (null before the first); inputs_after() carries the last one.
   std::shared_ptr<const SprayImage> spray;
+  // The lamps lit, the automatic ones resolved (sim/lights.hpp): the ego car's, and the traffic's
+  // in the order of `traffic`. Flashing lamps are lit at the frame's time (indicator_lit).
+  VehicleLights ego_lights;
+  std::vector<VehicleLights> traffic_lights;
 };
 
 class Simulation {
@@ -92,6 +98,11 @@ class Simulation {
 
   SimulationConfig config_;
   SceneState state_;
+  // Each vehicle's velocity at its last update, for automatic brake lights (traffic by id, those
+  // in the last list only).
+  VehicleMotion ego_motion_;
+  std::unordered_map<std::uint32_t, VehicleMotion> traffic_motion_;
+  void resolve_lights(bool vehicle_moved, bool traffic_moved);
   std::uint64_t seed_;
   double carry_s_ = 0.0;
   WiperMotion wipers_;

@@ -20,10 +20,22 @@ struct Rotation {
   double roll_deg = 0.0;
 };
 
+enum class Headlights : std::uint8_t { kAuto, kOff, kLow, kHigh };
+
+// A vehicle's lamps (sim/lights.hpp resolves the automatic ones).
+struct VehicleLights {
+  Headlights headlights = Headlights::kAuto;
+  bool brake = false;
+  bool left_indicator = false;  // both: the hazard lights
+  bool right_indicator = false;
+  bool reverse = false;
+};
+
 struct VehicleState {
   glm::dvec3 position_m{0.0};  // world frame, ground point under the rear axle centre
   Rotation rotation;
-  glm::dvec3 velocity_mps{0.0};  // world frame
+  glm::dvec3 velocity_mps{0.0};         // world frame
+  std::optional<VehicleLights> lights;  // absent: automatic
 };
 
 enum class WiperMode { kOff, kIntermittent, kLow, kHigh, kSingle, kManual };

@@ -418,3 +418,45 @@ TEST(ValidationTest, ReplaceTrafficWithAnEmptyListClearsIt) {
 
 }  // namespace
 }  // namespace downpour::rpc
+
+namespace downpour::rpc {
+namespace {
+
+TEST(ValidationTest, VehicleLightsAbsentAreAutomaticPresentAreTaken) {
+  v1::Update u;
+  u.mutable_vehicle()->mutable_position_m()->set_x(1.0);
+  sim::Update out;
+  ASSERT_TRUE(to_update(u, "update", Limits{}, &out).ok());
+  EXPECT_FALSE(out.vehicle->lights.has_value()) << "absent: automatic";
+
+  v1::VehicleLights* l = u.mutable_vehicle()->mutable_lights();
+  l->set_headlights(v1::HEADLIGHTS_HIGH);
+  l->set_brake(true);
+  l->set_left_indicator(true);
+  v1::TrafficVehicle* t = u.add_traffic();
+  t->set_id(4);
+  t->mutable_state()->mutable_lights()->set_right_indicator(true);
+  ASSERT_TRUE(to_update(u, "update", Limits{}, &out).ok());
+  ASSERT_TRUE(out.vehicle->lights.has_value());
+  EXPECT_EQ(out.vehicle->lights->headlights, sim::Headlights::kHigh);
+  EXPECT_TRUE(out.vehicle->lights->brake);
+  EXPECT_TRUE(out.vehicle->lights->left_indicator);
+  EXPECT_FALSE(out.vehicle->lights->right_indicator);
+  ASSERT_EQ(out.traffic->size(), 1u);
+  ASSERT_TRUE((*out.traffic)[0].state.lights.has_value());
+  EXPECT_EQ((*out.traffic)[0].state.lights->headlights, sim::Headlights::kAuto);
+  EXPECT_TRUE((*out.traffic)[0].state.lights->right_indicator);
+}
+
+TEST(ValidationTest, UnknownHeadlightsAreNamed) {
+  v1::Update u;
+  u.mutable_vehicle()->mutable_lights()->set_headlights(static_cast<v1::Headlights>(9));
+  EXPECT_TRUE(invalid_naming(update(u), "update.vehicle.lights.headlights"));
+  v1::Update t;
+  t.add_traffic()->mutable_state()->mutable_lights()->set_headlights(
+      static_cast<v1::Headlights>(-1));
+  EXPECT_TRUE(invalid_naming(update(t), "update.traffic[0].state.lights.headlights"));
+}
+
+}  // namespace
+}  // namespace downpour::rpc
