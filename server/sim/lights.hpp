@@ -28,7 +28,7 @@ struct LightsConfig {
   // Street lights: one about every spacing_m along the track, on each side in turn, the pole set
   // back from the pavement's edge, the lamp at the end of an arm over the road; lit below this
   // sun, or under a sky this overcast with the sun below 25 degrees.
-  double street_light_spacing_m = 40.0;
+  double street_light_spacing_m = 25.0;
   double street_light_setback_m = 1.5;  // the pole, beyond the paved edge
   double street_light_height_m = 9.0;   // the lamp over the road surface
   double street_light_arm_m = 2.0;      // the lamp, towards the road from the pole

@@ -1,0 +1,189 @@
+#include "server/render/light_set.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+#include <glm/vec4.hpp>
+
+#include "server/sim/pose.hpp"
+
+namespace downpour::render {
+namespace {
+
+const glm::vec3 kWhite{1.0f, 1.0f, 1.0f};
+const glm::vec3 kHeadlightWhite{1.0f, 0.97f, 0.9f};
+const glm::vec3 kRed{1.0f, 0.05f, 0.02f};
+const glm::vec3 kAmber{1.0f, 0.55f, 0.0f};
+
+float range_for(const glm::vec3& intensity_cd, float cutoff_lux) {
+  const float peak = std::max({intensity_cd.r, intensity_cd.g, intensity_cd.b});
+  return std::sqrt(peak / std::max(cutoff_lux, 1e-6f));
+}
+
+// One vehicle's lit lamps. to_world: its frame to the world; scale: its size against the ego
+// car's.
+void add_vehicle(const glm::dmat4& to_world, const glm::vec3& scale, const sim::VehicleLights& lit,
+                 bool flash_on, std::int32_t index, const LightSetConfig& c,
+                 std::vector<Light>& out) {
+  const glm::mat4 m(to_world);
+  const glm::vec3 forward = glm::normalize(glm::vec3(m[0])), up = glm::normalize(glm::vec3(m[2]));
+  auto lamp = [&](glm::vec3 at, glm::vec3 dir, glm::vec3 cd, float inner_deg, float outer_deg,
+                  LampKind kind) {
+    Light l;
+    l.position = glm::vec3(m * glm::vec4(at * scale, 1.0f));
+    l.direction = glm::normalize(dir);
+    l.intensity_cd = cd;
+    l.cos_inner = std::cos(glm::radians(inner_deg));
+    l.cos_outer = std::cos(glm::radians(outer_deg));
+    l.range_m = range_for(cd, c.cutoff_lux);
+    l.kind = kind;
+    l.vehicle = index;
+    out.push_back(l);
+  };
+  const bool heads =
+      lit.headlights == sim::Headlights::kLow || lit.headlights == sim::Headlights::kHigh;
+  for (float side : {1.0f, -1.0f}) {
+    const glm::vec3 head(c.headlamp_m.x, c.headlamp_m.y * side, c.headlamp_m.z);
+    const glm::vec3 tail(c.tail_lamp_m.x, c.tail_lamp_m.y * side, c.tail_lamp_m.z);
+    if (lit.headlights == sim::Headlights::kLow) {
+      const float down = glm::radians(c.low_beam_down_deg);
+      lamp(head, forward * std::cos(down) - up * std::sin(down), kHeadlightWhite * c.low_beam_cd,
+           c.low_beam_inner_deg, c.low_beam_outer_deg, LampKind::kHeadlight);
+    } else if (lit.headlights == sim::Headlights::kHigh) {
+      lamp(head, forward, kHeadlightWhite * c.high_beam_cd, c.high_beam_inner_deg,
+           c.high_beam_outer_deg, LampKind::kHeadlight);
+    }
+    if (heads)
+      lamp(tail, -forward, kRed * c.tail_cd, 20.0f, c.rear_lamp_outer_deg, LampKind::kTail);
+    if (lit.brake) {
+      lamp(tail, -forward, kRed * c.brake_cd, 20.0f, c.rear_lamp_outer_deg, LampKind::kBrake);
+    }
+    const bool indicator = side > 0 ? lit.left_indicator : lit.right_indicator;
+    if (indicator && flash_on) {
+      lamp(tail, -forward, kAmber * c.indicator_cd, 20.0f, c.rear_lamp_outer_deg,
+           LampKind::kIndicator);
+      lamp(head, forward, kAmber * c.indicator_cd, 20.0f, c.rear_lamp_outer_deg,
+           LampKind::kIndicator);
+    }
+    if (lit.reverse) {
+      lamp(tail, -forward, kWhite * c.reverse_cd, 20.0f, c.rear_lamp_outer_deg, LampKind::kReverse);
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<Light> build_lights(const sim::SceneState& scene,
+                                const std::vector<sim::StreetLight>& street,
+                                const glm::vec3& camera_m, const LightSetConfig& c) {
+  std::vector<Light> out;
+  const bool flash_on = sim::indicator_lit(scene.sim_time_s);
+  add_vehicle(sim::vehicle_to_world(scene.vehicle), glm::vec3(1.0f), scene.ego_lights, flash_on, -1,
+              c, out);
+  for (std::size_t i = 0; i < scene.traffic.size() && i < scene.traffic_lights.size(); ++i) {
+    const sim::TrafficVehicle& t = scene.traffic[i];
+    const glm::vec3 scale(t.size_m.x / 4.6, t.size_m.y / 1.8, t.size_m.z / 1.47);
+    add_vehicle(sim::vehicle_to_world(t.state), scale, scene.traffic_lights[i], flash_on,
+                static_cast<std::int32_t>(i), c, out);
+  }
+  if (sim::street_lights_on(scene.weather)) {
+    std::vector<std::pair<float, std::size_t>> near;
+    for (std::size_t i = 0; i < street.size(); ++i) {
+      const float d = glm::length(glm::vec3(street[i].lamp_m) - camera_m);
+      if (d <= c.street_within_m) near.emplace_back(d, i);
+    }
+    std::sort(near.begin(), near.end());
+    near.resize(std::min(near.size(), static_cast<std::size_t>(std::max(c.max_street, 0))));
+    for (const auto& [d, i] : near) {
+      Light l;
+      l.position = glm::vec3(street[i].lamp_m);
+      l.direction = {0.0f, 0.0f, -1.0f};
+      l.intensity_cd = glm::vec3(1.0f, 0.93f, 0.8f) * c.street_cd;
+      l.cos_inner = 1.0f;  // a cosine lobe down to the cut-off
+      l.cos_outer = std::cos(glm::radians(c.street_outer_deg));
+      l.range_m = range_for(l.intensity_cd, c.cutoff_lux);
+      l.kind = LampKind::kStreet;
+      out.push_back(l);
+    }
+  }
+  return out;
+}
+
+std::uint32_t LightTiles::max_per_tile() const {
+  return count.empty() ? 0 : *std::max_element(count.begin(), count.end());
+}
+
+double LightTiles::mean_per_tile() const {
+  if (count.empty()) return 0.0;
+  double sum = 0.0;
+  for (std::uint32_t n : count) sum += n;
+  return sum / static_cast<double>(count.size());
+}
+
+LightTiles bin_lights(const std::vector<Light>& lights, const glm::mat4& view_proj, int width,
+                      int height, int tile_px) {
+  LightTiles t;
+  t.tile_px = tile_px;
+  t.tiles_x = (width + tile_px - 1) / tile_px;
+  t.tiles_y = (height + tile_px - 1) / tile_px;
+  const std::size_t tiles = static_cast<std::size_t>(t.tiles_x) * t.tiles_y;
+  std::vector<std::vector<std::uint32_t>> per_tile(tiles);
+  // The frustum's side planes from the matrix's rows (Gribb and Hartmann): a sphere wholly
+  // outside one of them is dropped.
+  const glm::vec4 row0(view_proj[0][0], view_proj[1][0], view_proj[2][0], view_proj[3][0]);
+  const glm::vec4 row1(view_proj[0][1], view_proj[1][1], view_proj[2][1], view_proj[3][1]);
+  const glm::vec4 row3(view_proj[0][3], view_proj[1][3], view_proj[2][3], view_proj[3][3]);
+  const glm::vec4 planes[5] = {row3 + row0, row3 - row0, row3 + row1, row3 - row1, row3};
+  for (std::uint32_t i = 0; i < lights.size(); ++i) {
+    const Light& l = lights[i];
+    bool outside = false;
+    for (const glm::vec4& p : planes) {
+      const float len = glm::length(glm::vec3(p));
+      if ((glm::dot(glm::vec3(p), l.position) + p.w) / len < -l.range_m) outside = true;
+    }
+    if (outside) continue;
+    float x0 = std::numeric_limits<float>::max(), y0 = x0, x1 = -x0, y1 = -x0;
+    bool behind = false;
+    for (int k = 0; k < 8 && !behind; ++k) {
+      const glm::vec3 corner =
+          l.position + l.range_m * glm::vec3(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1);
+      const glm::vec4 c = view_proj * glm::vec4(corner, 1.0f);
+      if (c.w <= 1e-4f) {
+        behind = true;
+        break;
+      }
+      x0 = std::min(x0, c.x / c.w);
+      x1 = std::max(x1, c.x / c.w);
+      y0 = std::min(y0, c.y / c.w);
+      y1 = std::max(y1, c.y / c.w);
+    }
+    int tx0 = 0, tx1 = t.tiles_x - 1, ty0 = 0, ty1 = t.tiles_y - 1;
+    if (!behind) {
+      auto tile_of = [&](float ndc, int px, int n) {
+        const float pixel = (ndc * 0.5f + 0.5f) * static_cast<float>(px);
+        return std::clamp(static_cast<int>(std::floor(pixel / static_cast<float>(tile_px))), -1, n);
+      };
+      tx0 = std::max(tile_of(x0, width, t.tiles_x), 0);
+      tx1 = std::min(tile_of(x1, width, t.tiles_x), t.tiles_x - 1);
+      ty0 = std::max(tile_of(y0, height, t.tiles_y), 0);
+      ty1 = std::min(tile_of(y1, height, t.tiles_y), t.tiles_y - 1);
+    }
+    for (int ty = ty0; ty <= ty1; ++ty) {
+      for (int tx = tx0; tx <= tx1; ++tx)
+        per_tile[static_cast<std::size_t>(ty) * t.tiles_x + tx].push_back(i);
+    }
+  }
+  t.first.resize(tiles);
+  t.count.resize(tiles);
+  for (std::size_t k = 0; k < tiles; ++k) {
+    t.first[k] = static_cast<std::uint32_t>(t.lights.size());
+    t.count[k] = static_cast<std::uint32_t>(per_tile[k].size());
+    t.lights.insert(t.lights.end(), per_tile[k].begin(), per_tile[k].end());
+  }
+  return t;
+}
+
+}  // namespace downpour::render
