@@ -754,7 +754,9 @@ TEST(DrainTest, SigtermAnswersTheStepsInFlightEndsStreamsWithUnavailableAndExits
     step_status = stub->Step(&ctx, req, &resp);
     step_frames = resp.frames_size();
   });
-  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  // Time for the step to reach the server (longer for a slower server: under TSan it once came
+  // after the signal, refused as a new step). Answered before the signal, it passes as well.
+  std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(150 * time_scale())));
 
   const auto t0 = std::chrono::steady_clock::now();
   server.signal(SIGTERM);
