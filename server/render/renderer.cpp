@@ -62,9 +62,10 @@ constexpr int kHorizonDirections = 32;
 // The setts' relief and both reliefs' horizon maps: one array, the asphalt's layers first, packed
 // (relief::packed_layer).
 void upload_reliefs(SharedResources& shared, const std::shared_ptr<const relief::RoadReliefs>& r) {
-  shared.setts = upload_repeating(relief_image(setts_height_unit(r->setts.size, 3), r->setts.size,
-                                               relief::kSettsDepthM / r->setts.texel_m),
-                                  true);
+  std::vector<float> setts_unit = r->setts.height_m;  // back to [0, 1] for the texture
+  for (float& h : setts_unit) h /= relief::kSettsDepthM;
+  shared.setts = upload_repeating(
+      relief_image(setts_unit, r->setts.size, relief::kSettsDepthM / r->setts.texel_m), true);
   const relief::HorizonMaps* maps[] = {&r->asphalt_horizon, &r->setts_horizon};
   const int size = maps[0]->size, n = maps[0]->directions;
   shared.horizon_directions = n;

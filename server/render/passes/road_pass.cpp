@@ -39,6 +39,10 @@ RoadPass::RoadPass(SharedResources& shared)
     program.uniform("u_lanes_each_way").set(section.lanes_each_way);
     program.uniform("u_paved_half_width").set(static_cast<float>(shared.track.paved_half_width()));
   }
+  for (std::size_t p = 0; p < programs_.size(); ++p) {
+    mean_lit_[p] = programs_[p].uniform("u_relief_mean_lit");
+    near_split_[p] = programs_[p].uniform("u_near_split");
+  }
   for (std::size_t p = 3; p < programs_.size(); ++p) {
     programs_[p].uniform("u_horizon_directions").set(shared.horizon_directions);
     programs_[p]
@@ -69,7 +73,7 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
                        water->max_standing_mm > kPuddleFromMm;
   const glm::vec3& sun = frame.atmosphere.sun_radiance;
   drew_relief_ = relief_ && std::max({sun.r, sun.g, sun.b}) > kReliefSunFrom;
-  const ShaderProgram& plain = programs_[ripples ? 2 : mirror ? 1 : 0];
+  const std::size_t plain = ripples ? 2 : mirror ? 1 : 0;
   const glm::mat4 view_proj = frame.camera.projection * frame.camera.view;
   glEnable(GL_CLIP_DISTANCE1);
   // Relief shadows: the near road with them, the rest without (llvmpipe would fetch the horizon
@@ -83,15 +87,14 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
     const float elevation = std::asin(std::clamp(frame.atmosphere.sun_direction.z, 0.0f, 1.0f));
     mean_lit = {reliefs_->asphalt_horizon.mean_lit(elevation),
                 reliefs_->setts_horizon.mean_lit(elevation)};
-    const ShaderProgram& relief = programs_[(ripples ? 2 : mirror ? 1 : 0) + 3];
-    relief.use();
-    relief.uniform("u_relief_mean_lit").set(mean_lit);
-    relief.uniform("u_near_split").set(glm::vec2(reach, 1.0f));
+    programs_[plain + 3].use();
+    mean_lit_[plain + 3].set(mean_lit);
+    near_split_[plain + 3].set(glm::vec2(reach, 1.0f));
     chunks_.draw_visible(view_proj, frame.camera.position);
   }
-  plain.use();
-  plain.uniform("u_relief_mean_lit").set(mean_lit);
-  plain.uniform("u_near_split").set(glm::vec2(reach, -1.0f));
+  programs_[plain].use();
+  mean_lit_[plain].set(mean_lit);
+  near_split_[plain].set(glm::vec2(reach, -1.0f));
   chunks_.draw_visible(view_proj, frame.camera.position);
   glDisable(GL_CLIP_DISTANCE1);
 }

@@ -35,6 +35,9 @@ class RoadPass final : public Pass {
   // (road_surface.glsl): llvmpipe pays for both sides of a branch on every pixel, so the mirror,
   // the ripples and the shadows are programs of their own.
   std::array<ShaderProgram, 6> programs_;
+  // Each program's per-frame uniforms, looked up once.
+  std::array<Uniform, 6> mean_lit_;
+  std::array<Uniform, 6> near_split_;
   ChunkedMesh chunks_;
   std::shared_ptr<const relief::RoadReliefs> reliefs_;
   bool relief_ = true;
