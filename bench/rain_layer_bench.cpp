@@ -64,6 +64,7 @@ int main(int argc, char** argv) {
     for (double t = 0.0; t < 2.0; t += dt) step();
     render::RainLayer layer;
     std::vector<render::RainOccluder> occluders;
+    std::vector<render::RainLamp> lamps;
     std::vector<std::uint8_t> cabin;
     std::vector<double> ms, streaks, splashes;
     for (int i = 0; i < frames + 3; ++i) {
@@ -78,7 +79,7 @@ int main(int argc, char** argv) {
                                        glm::mat4(sim::vehicle_to_world(state.vehicle)),
                                        render::GlassView(camera, state.glass, spec.height),
                                        [&]() -> const sim::SceneState& { return state; }};
-      render::RainLayerInputs in = render::rain_layer_inputs(frame, layer_h, occluders);
+      render::RainLayerInputs in = render::rain_layer_inputs(frame, layer_h, occluders, lamps);
       // The cabin's tiles, as the pass has them (made once per camera there).
       if (cabin.empty()) {
         cabin = render::cabin_tiles(render::build_cockpit_interior(state.glass), camera, layer_w,

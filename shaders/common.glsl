@@ -33,6 +33,44 @@ vec3 diffuse_light_shadowed(vec3 n, float sun_lit) {
 }
 vec3 diffuse_light(vec3 n) { return diffuse_light_shadowed(n, 1.0); }
 
+// Lamp i's illuminance (lux, rgb) at p on a surface with normal n (the lamp block,
+// shader_interface.hpp): its intensity across its cones, over the distance squared. A dipped
+// beam (right-hand traffic) gives no light above 0.6 degrees under the horizon towards the
+// oncoming lanes, its cut-off rising at 15 degrees on the nearside.
+vec3 lamp_lux(int i, vec3 p, vec3 n) {
+  vec4 at = lamps.lamp[4 * i], axis = lamps.lamp[4 * i + 1];
+  vec4 cd = lamps.lamp[4 * i + 2], shape = lamps.lamp[4 * i + 3];
+  vec3 to = p - at.xyz;
+  float d2 = max(dot(to, to), 0.25);
+  vec3 l = to * inversesqrt(d2);
+  float beam = smoothstep(axis.w, cd.w, dot(l, axis.xyz));
+  float limit = -0.0105 + 0.268 * max(-dot(l.xy, shape.yz), 0.0);
+  beam *= mix(1.0, smoothstep(limit + 0.006, limit - 0.006, l.z), shape.x);
+  return cd.rgb * (beam * max(dot(n, -l), 0.0) / d2);
+}
+
+// The lamps' light on an upward surface at p, as radiance per unit albedo: the lamp map's fine
+// ring where it holds p (fading over its last 4 cells), else its coarse one (lamp_map.hpp).
+vec3 lamp_ground(vec3 p) {
+  vec4 r0 = frame.lamp_rings[0], r1 = frame.lamp_rings[1];
+  vec2 uv0 = (p.xy - r0.xy) * r0.z, uv1 = (p.xy - r1.xy) * r1.z;
+  vec2 e0 = min(uv0, 1.0 - uv0), e1 = min(uv1, 1.0 - uv1);
+  float in0 = clamp(min(e0.x, e0.y) * 32.0, 0.0, 1.0);
+  float in1 = clamp(min(e1.x, e1.y) * 32.0, 0.0, 1.0);
+  vec3 fine = texture(lamp_map_tex, vec3(uv0, 0.0)).rgb;
+  vec3 coarse = texture(lamp_map_tex, vec3(uv1, 1.0)).rgb;
+  return mix(coarse * in1, fine, in0) * step(0.5, frame.lamp_map.x);
+}
+
+// The ego car's headlights on a surface at p with normal n, per pixel (the first lamps of the
+// block), as radiance per unit albedo.
+vec3 ego_headlights(vec3 p, vec3 n) {
+  vec3 e = vec3(0.0);
+  int ego = int(lamps.count.x);
+  for (int i = 0; i < ego; ++i) e += lamp_lux(i, p, n);
+  return e * frame.lamp_map.y;
+}
+
 // Schlick's Fresnel approximation.
 float schlick(float cos_theta, float r0) {
   float m = 1.0 - clamp(cos_theta, 0.0, 1.0);

@@ -152,6 +152,35 @@ vec3 from_display(vec3 c) {
 // On the mirror's plane with its normal this is the pixel itself; a surface on a crest or in a
 // dip, tilted by the crown or moved by ripples, looks up its own reflection. The sky beyond the
 // mirror's edges.
+// The nearest lamps' glints on the water (after the ego car's headlights, whose light goes away
+// from its own eye, the lamp block's next kGlintLamps, ahead of the camera nearest first): the
+// mirror at a quarter of the view's size keeps a lamp as a dot at most, where a wet road at night
+// shows it as a long streak down towards the viewer. A microfacet lobe, the lamp's illuminance E
+// times D(h) / (4 n.v), as radiance (times pi and the exposure, as a lens's luminance shows); the
+// caller applies the Fresnel term. D is anisotropic, as the ripples and the texture's peaks tilt
+// the water more along the view than across it: (1 - (a / 0.05)^2 - (b / 0.16)^2)^8 for the half
+// vector's tilts a across and b along the view, normalized (pi 0.05 0.16 / 9 of the hemisphere).
+const int kGlintLamps = 4;
+vec3 lamp_glints(vec3 p, vec3 n, vec3 view) {
+  vec3 across = normalize(cross(n, view) + vec3(1e-5, 0.0, 0.0));
+  vec3 along = cross(across, n);
+  vec3 s = vec3(0.0);
+  int first = int(lamps.count.x), last = min(first + kGlintLamps, int(lamps.count.y));
+  for (int i = first; i < last; ++i) {
+    vec4 at = lamps.lamp[4 * i], axis = lamps.lamp[4 * i + 1], cd = lamps.lamp[4 * i + 2];
+    vec3 to = at.xyz - p;
+    float d2 = max(dot(to, to), 0.25);
+    vec3 l = to * inversesqrt(d2);
+    float beam = smoothstep(axis.w, cd.w, -dot(l, axis.xyz)) * step(0.0, dot(n, l));
+    vec3 h = normalize(l + view);
+    float a = dot(h, across), b = dot(h, along);
+    float x = max(1.0 - a * a * 400.0 - b * b * 40.0, 0.0);
+    float x2 = x * x, x4 = x2 * x2;
+    s += cd.rgb * (beam * x4 * x4 / d2);
+  }
+  return s * (frame.lamp_map.y * 3.14159 * 362.0 / (4.0 * max(dot(n, view), 0.1)));
+}
+
 vec3 mirrored(vec3 p, vec3 r, vec3 sky, float streak) {
   vec4 clip = frame.view_proj * vec4(p, 1.0);
   vec2 uv0 = clip.xy / clip.w * 0.5 + 0.5;
@@ -255,7 +284,7 @@ void main() {
             resolved);
 #endif
   float sun_lit = mix(1.0, lit, shadow_shows);
-  vec3 colour = albedo * diffuse_light_shadowed(n, sun_lit);
+  vec3 colour = albedo * (diffuse_light_shadowed(n, sun_lit) + lamp_ground(v_world) * max(n.z, 0.0));
 
   vec3 n_refl = normalize(mix(mix(n, n_geo, 0.8 * film), n_geo, pool));
 #ifdef ROAD_RIPPLES
@@ -272,6 +301,7 @@ void main() {
   vec3 refl = sky_gradient(r);
 #ifdef ROAD_MIRROR
   refl = mix(refl, mirrored(v_world, r, refl, 1.0 - pool), step(1e-3, smooth_water));
+  refl += lamp_glints(v_world, n_refl, view) * max(smooth_water, pool);
 #endif
   // A sheen of the sun on the film, broader than the sun in the mirror.
   float sun = max(dot(r, frame.sun_dir.xyz), 0.0);

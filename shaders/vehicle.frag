@@ -6,19 +6,48 @@ in vec2 v_uv;  // x material id (vehicle_geometry.hpp)
 in vec4 v_fog;
 out vec4 out_colour;
 uniform vec3 u_body_colour;
+// The lamps lit: x tail lamps, y brake lamps, z the left indicator, w the right (0 or 1); and the
+// headlamps (a street light's lamp): 0 off, 1 on (low beam), 2 high beam.
+uniform vec4 u_lamps;
+uniform float u_head;
+// A lit lamp's lens as radiance: its luminance (cd/m^2) times the exposure, at least `floor`
+// (by day a lit lamp still stands out from its housing), at most `cap` (a camera's red channel
+// clips long before the others: a red lamp's core stays red).
+vec3 lens(vec3 colour, float luminance, float floor_radiance, float cap) {
+  return colour * clamp(3.14159 * frame.lamp_map.y * luminance, floor_radiance, cap);
+}
 void main() {
   vec3 n = normalize(v_normal);
+  vec3 outward = n;  // the closed shapes' own side: what a lamp can light
   vec3 view = normalize(frame.camera_pos.xyz - v_world);
   n = dot(n, view) < 0.0 ? -n : n;
   int material = int(v_uv.x + 0.5);
   vec3 albedo = u_body_colour;
   float r0 = 0.04, gloss = 1.0;
   vec3 emit = vec3(0.0);
+  const vec3 red = vec3(1.0, 0.005, 0.003), amber = vec3(1.0, 0.45, 0.0);
   if (material == 1) { albedo = vec3(0.02, 0.025, 0.03); r0 = 0.06; }       // glass
   else if (material == 2) { albedo = vec3(0.02); gloss = 0.1; }              // tyre
-  else if (material == 3) { albedo = vec3(0.3, 0.02, 0.02); emit = vec3(0.6, 0.03, 0.02); }  // lamp
+  else if (material == 3) {                                                  // tail and brake
+    albedo = vec3(0.3, 0.02, 0.02);
+    emit = lens(red, 100.0 * u_lamps.x + 1500.0 * u_lamps.y,
+                0.5 * u_lamps.x + 1.2 * u_lamps.y, 1.5 + 1.5 * u_lamps.y);
+  }
   else if (material == 4) { albedo = vec3(0.03); gloss = 0.2; }              // trim
-  vec3 colour = albedo * diffuse_light(n) + emit;
+  else if (material == 5 || material == 8) {                                 // headlamp, street lamp
+    albedo = vec3(0.45);
+    emit = lens(vec3(1.0, 0.96, 0.88), material == 8 ? 5e4 : 2e5 * u_head, 1.5, 1e4) *
+           step(0.5, u_head);
+  }
+  else if (material == 6 || material == 7) {                                // indicators
+    albedo = vec3(0.35, 0.2, 0.02);
+    emit = lens(amber, 5000.0, 1.0, 3.0) * (material == 6 ? u_lamps.z : u_lamps.w);
+  }
+  // The lamps' light on the ground as what falls on this face: whole on a roof, a tenth on a side
+  // (the street lights shine down; the cars' own beams are the ego car's, per pixel).
+  vec3 light = diffuse_light(n) + lamp_ground(v_world) * (0.1 + 0.9 * max(outward.z, 0.0)) +
+               ego_headlights(v_world, outward);
+  vec3 colour = albedo * light + emit;
   float f = schlick(dot(n, view), r0);
   colour += sky_gradient(reflect(-view, n)) * f * gloss;
   out_colour = vec4(to_display(apply_fog(colour, v_fog)), 1.0);

@@ -67,6 +67,9 @@ Atmosphere atmosphere_from(const sim::Weather& w) {
                   static_cast<float>(sim::rain_extinction_per_m(w.rain_rate_mm_h));
   a.fog_colour = a.sky_horizon;
   a.wetness = std::clamp(rain / 5.0f, 0.0f, 1.0f);
+  // Between day and night the exposure follows the daylight geometrically (log-linearly).
+  const float night_exposure = 0.05f, day_exposure = 1.4e-5f;
+  a.lux_exposure = night_exposure * std::pow(day_exposure / night_exposure, day);
   return a;
 }
 

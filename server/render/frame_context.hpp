@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include <glm/mat4x4.hpp>
 
@@ -18,6 +19,7 @@ namespace downpour::render {
 namespace relief {
 struct RoadReliefs;
 }
+struct Light;
 
 struct FrameContext {
   // The simulator's inputs for this frame: pose, weather, traffic, the time after the step. Its
@@ -34,6 +36,9 @@ struct FrameContext {
   // Chunked geometry takes its level of detail as from this many times as far (the road
   // reflection, at a quarter of the view's size, needs a quarter of the detail).
   float detail_distance_scale = 1.0f;
+  // The frame's lamps (light_set.hpp), once the renderer has made them: for the passes that light
+  // what the lamp map does not hold (the rain's drops).
+  const std::vector<Light>* lights = nullptr;
 
   const sim::WindshieldState& water() const { return stepped().windshield; }
   const sim::RainState& rain() const { return stepped().rain; }
@@ -73,6 +78,7 @@ struct SharedResources {
   Texture horizon;  // relief::road_reliefs' horizon maps, RG16F, a layer per azimuth and relief
   int horizon_directions = 0;
   std::shared_ptr<const relief::RoadReliefs> reliefs;
+  std::vector<sim::StreetLight> street_lights;  // the track's (sim/lights.hpp)
 };
 
 // Axis-aligned box against the view frustum's side and near planes.

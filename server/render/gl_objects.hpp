@@ -68,6 +68,10 @@ class Uniform {
   void set(glm::vec3 v) const { glProgramUniform3f(program_, location_, v.x, v.y, v.z); }
   void set(glm::vec4 v) const { glProgramUniform4f(program_, location_, v.x, v.y, v.z, v.w); }
   void set(const glm::mat4& m) const;
+  // An array of vec4 from its first element on.
+  void set(const glm::vec4* v, int count) const {
+    glProgramUniform4fv(program_, location_, count, &v->x);
+  }
 
  private:
   GLuint program_ = 0;

@@ -4,10 +4,13 @@
 #include <cmath>
 #include <limits>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
 
+#include "server/render/shader_interface.hpp"
 #include "server/sim/pose.hpp"
 
 namespace downpour::render {
@@ -39,6 +42,7 @@ void add_vehicle(const glm::dmat4& to_world, const glm::vec3& scale, const sim::
     l.cos_inner = std::cos(glm::radians(inner_deg));
     l.cos_outer = std::cos(glm::radians(outer_deg));
     l.range_m = range_for(cd, c.cutoff_lux);
+    l.ground_z = (m * glm::vec4(at.x * scale.x, at.y * scale.y, 0.0f, 1.0f)).z;
     l.kind = kind;
     l.vehicle = index;
     out.push_back(l);
@@ -52,6 +56,7 @@ void add_vehicle(const glm::dmat4& to_world, const glm::vec3& scale, const sim::
       const float down = glm::radians(c.low_beam_down_deg);
       lamp(head, forward * std::cos(down) - up * std::sin(down), kHeadlightWhite * c.low_beam_cd,
            c.low_beam_inner_deg, c.low_beam_outer_deg, LampKind::kHeadlight);
+      out.back().low_beam = true;
     } else if (lit.headlights == sim::Headlights::kHigh) {
       lamp(head, forward, kHeadlightWhite * c.high_beam_cd, c.high_beam_inner_deg,
            c.high_beam_outer_deg, LampKind::kHeadlight);
@@ -76,18 +81,24 @@ void add_vehicle(const glm::dmat4& to_world, const glm::vec3& scale, const sim::
 
 }  // namespace
 
+sim::VehicleLights shown_lights(const sim::VehicleLights& lights, const sim::Weather& weather) {
+  return sim::resolve_lights(lights, weather, lights.brake);
+}
+
 std::vector<Light> build_lights(const sim::SceneState& scene,
                                 const std::vector<sim::StreetLight>& street,
                                 const glm::vec3& camera_m, const LightSetConfig& c) {
   std::vector<Light> out;
   const bool flash_on = sim::indicator_lit(scene.sim_time_s);
-  add_vehicle(sim::vehicle_to_world(scene.vehicle), glm::vec3(1.0f), scene.ego_lights, flash_on, -1,
-              c, out);
-  for (std::size_t i = 0; i < scene.traffic.size() && i < scene.traffic_lights.size(); ++i) {
+  add_vehicle(sim::vehicle_to_world(scene.vehicle), glm::vec3(1.0f),
+              shown_lights(scene.ego_lights, scene.weather), flash_on, -1, c, out);
+  for (std::size_t i = 0; i < scene.traffic.size(); ++i) {
     const sim::TrafficVehicle& t = scene.traffic[i];
     const glm::vec3 scale(t.size_m.x / 4.6, t.size_m.y / 1.8, t.size_m.z / 1.47);
-    add_vehicle(sim::vehicle_to_world(t.state), scale, scene.traffic_lights[i], flash_on,
-                static_cast<std::int32_t>(i), c, out);
+    const sim::VehicleLights lights =
+        i < scene.traffic_lights.size() ? scene.traffic_lights[i] : sim::VehicleLights{};
+    add_vehicle(sim::vehicle_to_world(t.state), scale, shown_lights(lights, scene.weather),
+                flash_on, static_cast<std::int32_t>(i), c, out);
   }
   if (sim::street_lights_on(scene.weather)) {
     std::vector<std::pair<float, std::size_t>> near;
@@ -102,14 +113,102 @@ std::vector<Light> build_lights(const sim::SceneState& scene,
       l.position = glm::vec3(street[i].lamp_m);
       l.direction = {0.0f, 0.0f, -1.0f};
       l.intensity_cd = glm::vec3(1.0f, 0.93f, 0.8f) * c.street_cd;
-      l.cos_inner = 1.0f;  // a cosine lobe down to the cut-off
+      l.cos_inner = std::cos(glm::radians(c.street_inner_deg));
       l.cos_outer = std::cos(glm::radians(c.street_outer_deg));
       l.range_m = range_for(l.intensity_cd, c.cutoff_lux);
+      l.ground_z =
+          static_cast<float>(street[i].lamp_m.z - sim::LightsConfig{}.street_light_height_m);
       l.kind = LampKind::kStreet;
       out.push_back(l);
     }
   }
   return out;
+}
+
+float beam_towards(const Light& l, const glm::vec3& dir, float stray) {
+  const float t = std::clamp(
+      (glm::dot(dir, l.direction) - l.cos_outer) / std::max(l.cos_inner - l.cos_outer, 1e-4f), 0.0f,
+      1.0f);
+  float beam = t * t * (3.0f - 2.0f * t);
+  if (l.low_beam) {
+    glm::vec2 left(-l.direction.y, l.direction.x);
+    const float len = glm::length(left);
+    left = len > 1e-4f ? left / len : glm::vec2(1.0f, 0.0f);
+    // (As common.glsl's lamp_lux: 0.6 degrees under the horizon, rising at 15 on the nearside.)
+    const float limit = -0.0105f + 0.268f * std::max(-glm::dot(glm::vec2(dir), left), 0.0f);
+    const float u = std::clamp((limit + 0.006f - dir.z) / 0.012f, 0.0f, 1.0f);
+    beam *= stray + (1.0f - stray) * u * u * (3.0f - 2.0f * u);
+  }
+  return beam;
+}
+
+float ground_lux(const Light& l, const glm::vec2& xy) {
+  const glm::vec3 to = glm::vec3(xy, l.ground_z) - l.position;
+  const float d2 = std::max(glm::dot(to, to), 0.25f);
+  const glm::vec3 dir = to / std::sqrt(d2);
+  return l.intensity_cd.g * beam_towards(l, dir) * std::max(-dir.z, 0.0f) / d2;
+}
+
+glm::vec4 lamp_footprint(const Light& l, float cut_lux) {
+  const float h = l.position.z - l.ground_z;
+  glm::vec4 box(1.0f, 1.0f, -1.0f, -1.0f);
+  if (h <= 0.0f || cut_lux <= 0.0f) return box;
+  const float peak = std::max({l.intensity_cd.r, l.intensity_cd.g, l.intensity_cd.b});
+  const float reach = std::cbrt(peak * h / cut_lux);
+  constexpr int kAzimuths = 16, kSteps = 16;
+  const glm::vec2 at(l.position);
+  bool any = false;
+  for (int a = 0; a < kAzimuths; ++a) {
+    const float phi = 6.2831853f * static_cast<float>(a) / kAzimuths;
+    const glm::vec2 dir(std::cos(phi), std::sin(phi));
+    // The furthest sample along the azimuth that gets more than the cut, and one step beyond.
+    float last = -1.0f;
+    for (int k = 0; k <= kSteps; ++k) {
+      const float r = reach * static_cast<float>(k) / kSteps;
+      if (ground_lux(l, at + dir * r) > cut_lux) last = r;
+    }
+    if (last < 0.0f) continue;
+    const glm::vec2 p = at + dir * std::min(last + reach / kSteps, reach);
+    if (!any) box = glm::vec4(at, at);
+    any = true;
+    box = glm::vec4(glm::min(glm::vec2(box), p), glm::max(glm::vec2(box.z, box.w), p));
+  }
+  return box;
+}
+
+PackedLamps pack_lamps(const std::vector<Light>& lights, const glm::vec3& camera_m,
+                       const glm::vec3& camera_forward, LampBlock& out) {
+  std::vector<std::pair<float, const Light*>> order;
+  int ego = 0;
+  for (const Light& l : lights) {
+    if (l.kind == LampKind::kTail) continue;
+    const bool ego_head = l.vehicle < 0 && l.kind == LampKind::kHeadlight;
+    if (ego_head) ++ego;
+    // The ego car's headlights sort before everything (negative keys), in their own order.
+    const glm::vec3 to = l.position - camera_m;
+    const float behind = glm::dot(to, camera_forward) < 0.0f ? 1e6f : 0.0f;
+    order.emplace_back(ego_head ? -1e9f + static_cast<float>(ego) : glm::length(to) + behind, &l);
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  PackedLamps packed;
+  packed.count = static_cast<int>(std::min<std::size_t>(order.size(), kMaxLamps));
+  packed.ego = std::min(ego, packed.count);
+  packed.ground_boxes.resize(packed.count);
+  for (int i = 0; i < packed.count; ++i) {
+    const Light& l = *order[i].second;
+    packed.ground_boxes[i] = lamp_footprint(l, kGroundCutLux);
+    out.lamp[4 * i + 0] = glm::vec4(l.position, l.ground_z);
+    out.lamp[4 * i + 1] = glm::vec4(l.direction, l.cos_outer);
+    out.lamp[4 * i + 2] = glm::vec4(l.intensity_cd, l.cos_inner);
+    glm::vec2 left(-l.direction.y, l.direction.x);
+    const float len = glm::length(left);
+    left = len > 1e-4f ? left / len : glm::vec2(1.0f, 0.0f);
+    out.lamp[4 * i + 3] = glm::vec4(l.low_beam ? 1.0f : 0.0f, left, 0.0f);
+  }
+  out.count =
+      glm::vec4(static_cast<float>(packed.ego), static_cast<float>(packed.count), 0.0f, 0.0f);
+  return packed;
 }
 
 std::uint32_t LightTiles::max_per_tile() const {

@@ -11,6 +11,7 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
+#include "server/render/shader_interface.hpp"
 #include "server/sim/lights.hpp"
 #include "server/sim/simulation.hpp"
 
@@ -25,6 +26,8 @@ struct Light {
   float cos_inner = -1.0f;       // full intensity within this cone,
   float cos_outer = -1.0f;       // none beyond this one
   float range_m = 0.0f;          // where its illuminance falls to LightSetConfig::cutoff_lux
+  float ground_z = 0.0f;         // the height of the ground under it (its light's receiving plane)
+  bool low_beam = false;         // a dipped beam: cut off above a line, raised on the nearside
   LampKind kind = LampKind::kHeadlight;
   std::int32_t vehicle = -1;  // -1 the ego car, else its index in the scene's traffic
 };
@@ -50,20 +53,56 @@ struct LightSetConfig {
   float indicator_cd = 200.0f;
   float reverse_cd = 150.0f;
   float rear_lamp_outer_deg = 80.0f;  // they shine backwards, widely
-  // Street lights: 8,000 cd straight down, to none 75 degrees from it; the nearest max_street
-  // within street_within_m of the camera.
-  float street_cd = 8000.0f;
-  float street_outer_deg = 75.0f;
+  // Street lights: a road luminaire's wide flat beam, 3,000 cd out to 65 degrees from straight
+  // down and none beyond 80 (37 lux under the lamp, 9 m up; 7 halfway between two, as lit roads
+  // have); the nearest max_street within street_within_m of the camera.
+  float street_cd = 3000.0f;
+  float street_inner_deg = 65.0f;
+  float street_outer_deg = 80.0f;
   int max_street = 20;
   float street_within_m = 250.0f;
   float cutoff_lux = 1.0f;  // a light's range: where it gives this much
 };
+
+// A vehicle's lamps as drawn: the scene's, whose automatic headlights the simulation resolves
+// (sim/lights.hpp), resolved here too for a scene made without it (automatic: low beams when
+// automatic_headlights_on; the brake lamps as given).
+sim::VehicleLights shown_lights(const sim::VehicleLights& lights, const sim::Weather& weather);
 
 // The frame's lights: the ego car's and the traffic's lamps that are lit at the scene's time, and
 // the street lights (when lit) nearest to the camera.
 std::vector<Light> build_lights(const sim::SceneState& scene,
                                 const std::vector<sim::StreetLight>& street,
                                 const glm::vec3& camera_m, const LightSetConfig& config = {});
+
+// The lamps as the shaders read them (shader_interface.hpp's LampBlock): the ego car's headlights
+// first (those that vehicle.frag evaluates per pixel), then every other lamp that lights its
+// surroundings, those ahead of the camera (along `camera_forward`) nearest first, then those
+// behind it (the wet road's glints take the first few after the ego car's), up to kMaxLamps. Tail
+// lamps light nothing worth a shader's loop (4 cd): they show as lamps on the cars (vehicle.frag),
+// not as lights.
+struct PackedLamps {
+  int ego = 0;    // the ego car's headlights, first
+  int count = 0;  // all packed
+  // Per packed lamp, the box (x0, y0, x1, y1; world m) of the ground it gives more than
+  // kGroundCutLux (lamp_footprint): what the lamp map draws of it.
+  std::vector<glm::vec4> ground_boxes;
+};
+// Below this a lamp's light on the ground is left out (the lamp map draws E - kGroundCutLux), so
+// that each lamp draws only its footprint: 1 lux shows at night as 1/150 of white on asphalt.
+inline constexpr float kGroundCutLux = 1.0f;
+// The share of a lamp's intensity on its axis that it sends along the unit direction `dir`: its
+// cones, and a dipped beam's cut-off, above which it leaves `stray` of it.
+float beam_towards(const Light& light, const glm::vec3& dir, float stray = 0.0f);
+// A lamp's illuminance (lux, the green channel) on its ground plane at xy, as the shaders' lamp_lux
+// gives it on an upward surface.
+float ground_lux(const Light& light, const glm::vec2& xy);
+// The box around the ground where the lamp gives more than cut_lux: its illuminance sampled along
+// 32 azimuths out to where no lamp of its intensity and height could give that much (an upward
+// surface at distance d under a lamp h above gets at most I h / d^3). Empty (x0 > x1) if none.
+glm::vec4 lamp_footprint(const Light& light, float cut_lux);
+PackedLamps pack_lamps(const std::vector<Light>& lights, const glm::vec3& camera_m,
+                       const glm::vec3& camera_forward, LampBlock& out);
 
 // Screen tiles with the lights that may reach what they show: each light's sphere of influence
 // (its position and range) against the view's frustum, its screen rectangle from its bounding

@@ -252,9 +252,38 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
   // occluders' depths, or null for a streak that lies wholly outside them).
   const std::uint16_t* const occluded = occlude(in, sx, sy, cx, cy);
   auto put = [](std::vector<Texel>& out, const std::uint16_t* occluded, std::size_t i,
-                std::uint32_t alpha, std::uint16_t depth) {
+                std::uint32_t alpha, std::uint16_t depth, std::uint32_t level) {
     if (occluded && depth > occluded[i]) return;
-    add(out[i], alpha, depth);
+    add(out[i], alpha, depth, level);
+  };
+  // The lamps' light on a drop at p (camera frame), in levels (Texel::lit).
+  const std::size_t lamp_count = std::min(in.lamps.size(), RainLayerInputs::kMaxLamps);
+  // A drop's phase function, roughly: water drops send most of a beam on forwards (an oncoming
+  // lamp's halo), some back (a beam from behind the camera), little sideways (a street lamp above).
+  auto lamp_level = [&](const glm::vec3& p) -> std::uint32_t {
+    float radiance = 0.0f;
+    const glm::vec3 to_camera = -p / std::max(glm::length(p), 1e-3f);
+    for (std::size_t k = 0; k < lamp_count; ++k) {
+      const RainLamp& lamp = in.lamps[k];
+      const glm::vec3 to = p - lamp.position;
+      const float d2 = std::max(glm::dot(to, to), 0.25f);
+      const glm::vec3 l = to / std::sqrt(d2);
+      const float t = std::clamp((glm::dot(l, lamp.axis) - lamp.cos_outer) /
+                                     std::max(lamp.cos_inner - lamp.cos_outer, 1e-4f),
+                                 0.0f, 1.0f);
+      float beam = t * t * (3.0f - 2.0f * t);
+      if (lamp.low_beam) {
+        const float limit = -0.0105f + 0.268f * std::max(-glm::dot(l, lamp.left), 0.0f);
+        if (glm::dot(l, in.up) > limit) beam = 0.0f;
+      }
+      const float c = glm::dot(l, to_camera);
+      const float fwd = std::max(c, 0.0f), back = std::max(-c, 0.0f);
+      const float f2 = fwd * fwd, f4 = f2 * f2;
+      const float phase = 0.06f + 0.3f * back * back + 2.0f * f4 * f4;
+      radiance += lamp.intensity * phase * beam / d2;
+    }
+    const float level = std::sqrt(std::min(radiance / kLitMax, 1.0f)) * (kLitLevels - 1);
+    return static_cast<std::uint32_t>(level + 0.5f);
   };
   auto draw = [&](std::size_t begin, std::size_t end, std::vector<Texel>& out, Bounds& dirty,
                   Batch& bt) {
@@ -279,6 +308,11 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
           const auto whole = static_cast<std::uint32_t>(units + 0.5f);
           const std::uint16_t depth_c = depth_cm(depth);
           const float dx = tx - hx, dy = ty - hy;
+          // The lamps' light at the streak's head (back from the screen to the camera's frame).
+          const std::uint32_t level =
+              lamp_count
+                  ? lamp_level(glm::vec3((hx - cx) / sx * depth, (hy - cy) / sy * depth, -depth))
+                  : 0;
 
           // A Wu line, clipped to the layer: one texel a column along its major axis, shared by the
           // two nearest across (and whole texels between them for a drop wider than a texel).
@@ -348,12 +382,12 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
             const float frac = std::clamp(b - static_cast<float>(base), 0.0f, 1.0f);
             std::size_t i = m * major_stride + (base - extra) * minor_stride;
             const auto far_share = static_cast<std::uint32_t>(units * frac + 0.5f);
-            put(out, occ, i, whole - std::min(far_share, whole), depth_c);
+            put(out, occ, i, whole - std::min(far_share, whole), depth_c, level);
             for (int k = 1 - extra; k <= extra; ++k) {
               i += minor_stride;
-              put(out, occ, i, whole, depth_c);
+              put(out, occ, i, whole, depth_c, level);
             }
-            put(out, occ, i + minor_stride, far_share, depth_c);
+            put(out, occ, i + minor_stride, far_share, depth_c, level);
           }
           b_min -= extra;
           b_max += extra + 2;
@@ -402,10 +436,17 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
   // coverings, 1 - exp(-sum), whatever the order; the streaks carry the light, hazed by the
   // distance of the nearest.
   const CoverageTable& coverage = coverage_table();
-  glm::uvec3 hazed[kHazeSteps + 1];
-  for (int i = 0; i <= kHazeSteps; ++i) {
-    const glm::vec3 c = to_display(glm::mix(in.haze, in.light, transmittance[i]));
-    hazed[i] = glm::uvec3(c * 255.0f + 0.5f);
+  // By the nearest streak's distance and, with lamps, the texel's mean lamp light.
+  const int levels = lamp_count ? kLitLevels : 1;
+  std::vector<glm::uvec3>& hazed = hazed_;
+  hazed.resize(static_cast<std::size_t>(kHazeSteps + 1) * levels);
+  for (int k = 0; k < levels; ++k) {
+    const float f = static_cast<float>(k) / (kLitLevels - 1);
+    const glm::vec3 light = in.light + in.lamp_colour * (f * f * kLitMax);
+    for (int i = 0; i <= kHazeSteps; ++i) {
+      const glm::vec3 c = to_display(glm::mix(in.haze, light, transmittance[i]));
+      hazed[static_cast<std::size_t>(k) * (kHazeSteps + 1) + i] = glm::uvec3(c * 255.0f + 0.5f);
+    }
   }
   // Rows [y0, y1), whole rows of tiles but at the layer's ends (two threads mark tiles apart).
   const bool cabin = in.cabin_tiles.size() == tile_lit_.size();
@@ -434,7 +475,13 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
         const std::uint32_t sum = std::uint32_t{first[i].alpha} + second[i].alpha;
         const std::uint32_t depth = std::min(first[i].depth, second[i].depth);
         const std::uint32_t a = coverage.at_units(sum);
-        const glm::uvec3& c = hazed[std::min(depth / kHazeStepCm, std::uint32_t{kHazeSteps})];
+        const std::uint32_t lit = std::uint32_t{first[i].lit} + second[i].lit;
+        const std::uint32_t level =
+            levels > 1
+                ? std::min<std::uint32_t>(lit * kLitLevels / std::max(sum, 1u), kLitLevels - 1)
+                : 0;
+        const glm::uvec3& c = hazed[level * (kHazeSteps + 1) +
+                                    std::min(depth / kHazeStepCm, std::uint32_t{kHazeSteps})];
         // Premultiplied: each channel times the coverage, rounded, in bytes.
         out[i] = ((c.r * a + 127) / 255) | ((c.g * a + 127) / 255) << 8 |
                  ((c.b * a + 127) / 255) << 16 | a << 24;

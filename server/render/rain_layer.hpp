@@ -29,6 +29,17 @@ struct RainOccluder {
   glm::vec3 lo{0.0f}, hi{0.0f};
 };
 
+// A lamp that lights the drops in its beam (the ego car's headlights, and the strongest others),
+// in the camera's frame.
+struct RainLamp {
+  glm::vec3 position{0.0f};
+  glm::vec3 axis{0.0f, 0.0f, -1.0f};  // the beam's, unit
+  glm::vec3 left{1.0f, 0.0f, 0.0f};   // level, unit: a dipped beam's cut-off rises on the right
+  float intensity = 0.0f;             // cd times the exposure times a drop's scattering share
+  float cos_outer = -1.0f, cos_inner = -1.0f;
+  bool low_beam = false;
+};
+
 struct RainLayerInputs {
   glm::mat4 view{1.0f};  // world to camera (GL axes: looking down -z)
   double tan_half_fov_x = 0.0;
@@ -39,6 +50,12 @@ struct RainLayerInputs {
   glm::vec3 light{0.5f};            // linear light a drop carries (before the haze)
   glm::vec3 haze{0.5f};             // linear colour of the haze between the drop and the camera
   float haze_per_m = 0.0f;          // extinction
+  // The lamps whose beams light the drops (at most kMaxLamps), their light's colour, and the
+  // world's up in the camera's frame (for a dipped beam's cut-off).
+  static constexpr std::size_t kMaxLamps = 4;
+  std::span<const RainLamp> lamps;
+  glm::vec3 lamp_colour{1.0f, 0.96f, 0.88f};
+  glm::vec3 up{0.0f, 1.0f, 0.0f};
   float opacity = 0.55f;
   float pixels_per_texel = 2.0f;     // the view's pixels per layer texel, across
   glm::dmat4 vehicle_to_world{1.0};  // the ego car at the frame's time, for the splashes on it
@@ -99,13 +116,20 @@ class RainLayer {
   struct Texel {
     std::uint16_t alpha = 0;           // sum of the streaks' opacities, saturating
     std::uint16_t depth = kUntouched;  // nearest streak (cm)
+    std::uint16_t lit = 0;  // sum of the opacities times their lamp light's level / kLitLevels
   };
+  // A streak's lamp light in levels, 0 .. kLitLevels - 1, of up to kLitMax radiance (squared:
+  // finer where it is dim).
+  static constexpr int kLitLevels = 16;
+  static constexpr float kLitMax = 6.0f;
   static std::uint16_t depth_cm(float depth_m) {
     return static_cast<std::uint16_t>(std::clamp(depth_m * 100.0f + 0.5f, 0.0f, 65534.0f));
   }
-  static void add(Texel& t, std::uint32_t alpha, std::uint16_t depth) {
+  static void add(Texel& t, std::uint32_t alpha, std::uint16_t depth, std::uint32_t level = 0) {
     t.alpha = static_cast<std::uint16_t>(std::min<std::uint32_t>(t.alpha + alpha, 0xffff));
     t.depth = std::min(t.depth, depth);
+    t.lit = static_cast<std::uint16_t>(
+        std::min<std::uint32_t>(t.lit + alpha * level / kLitLevels, 0xffff));
   }
   // The most whole texels across a streak between its two shared ones (a drop a few texels
   // wide, just past kNearestM).
@@ -132,6 +156,7 @@ class RainLayer {
 
   int width_ = 0, height_ = 0;
   std::vector<std::uint16_t> occluder_depth_;  // cm
+  std::vector<glm::uvec3> hazed_;              // the resolve's colours by lamp light and distance
   Bounds occluded_;
   sim::WorkerThread helper_;
   // Each thread's batch of drops being projected (rain_layer.cpp), made once.

@@ -16,15 +16,19 @@
 #include <glm/trigonometric.hpp>
 
 #include "server/render/frame_context.hpp"
+#include "server/render/lamp_map.hpp"
+#include "server/render/light_set.hpp"
 #include "server/render/pass.hpp"
 #include "server/render/passes/cockpit_pass.hpp"
 #include "server/render/passes/glass_background_pass.hpp"
 #include "server/render/passes/glass_composite_pass.hpp"
 #include "server/render/passes/glass_water_pass.hpp"
+#include "server/render/passes/lamp_glow_pass.hpp"
 #include "server/render/passes/rain_pass.hpp"
 #include "server/render/passes/road_pass.hpp"
 #include "server/render/passes/sky_pass.hpp"
 #include "server/render/passes/spray_pass.hpp"
+#include "server/render/passes/street_light_pass.hpp"
 #include "server/render/passes/terrain_pass.hpp"
 #include "server/render/passes/vehicle_pass.hpp"
 #include "server/render/passes/windshield_pass.hpp"
@@ -220,6 +224,15 @@ struct Renderer::Impl {
   std::unique_ptr<EglContext> context;
   std::unique_ptr<SharedResources> shared;
   Buffer frame_ubo;
+  // The frame's lamps: their block (binding kLampBlockBinding), the map of their light on the
+  // ground, and the frame block's fields that place it.
+  Buffer lamp_ubo;
+  LampBlock lamp_block;
+  std::unique_ptr<LampMap> lamp_map;
+  std::vector<Light> frame_lights;
+  bool lamps_on = true;
+  glm::vec4 lamp_params{0.0f};
+  glm::mat4 lamp_rings{0.0f};
   std::vector<std::unique_ptr<Pass>> passes;
   std::array<std::vector<Pass*>, sim::kViewCount> views;  // each view's passes, in order
   std::map<std::tuple<Resource, int, int>, Transient> transients;
@@ -307,6 +320,8 @@ struct Renderer::Impl {
     b.road_water = water.road_water;
     b.road_water_rings = water.road_water_rings;
     b.road_water_state = water.road_water_state;
+    b.lamp_map = lamp_params;
+    b.lamp_rings = lamp_rings;
     glNamedBufferSubData(frame_ubo.id(), 0, sizeof(b), &b);
   }
 
@@ -539,6 +554,34 @@ struct Renderer::Impl {
     for (Resource res : d.writes) written[index(res)] = true;
   }
 
+  // The frame's lamps into their block, and their light on the ground into the lamp map (for the
+  // views that show the ground).
+  void prepare_lamps(FrameContext& f) {
+    frame_lights.clear();
+    // By day the lamps' light is lost in the sun's (a low beam's 1,000 lux 4 m ahead shows as
+    // 0.014 of white at noon): none is drawn until the exposure makes it count. Their lit lenses
+    // still show (vehicle.frag).
+    constexpr float kLampsFromExposure = 2e-4f;
+    if (lamps_on && f.atmosphere.lux_exposure >= kLampsFromExposure)
+      frame_lights = build_lights(f.scene, shared->street_lights, f.camera.position);
+    f.lights = &frame_lights;
+    const std::vector<Light>& lights = frame_lights;
+    const glm::mat4& view = f.camera.view;
+    const glm::vec3 forward(-view[0][2], -view[1][2], -view[2][2]);
+    const PackedLamps packed = pack_lamps(lights, f.camera.position, forward, lamp_block);
+    const std::size_t bytes = sizeof(glm::vec4) * (1 + 4 * static_cast<std::size_t>(packed.count));
+    glNamedBufferSubData(lamp_ubo.id(), 0, static_cast<GLsizeiptr>(bytes), &lamp_block);
+    lamp_rings = place_lamp_rings(f.camera.position, forward).windows;
+    const bool map = packed.count > 0 && f.spec.view != sim::View::kWindshield &&
+                     f.spec.view != sim::View::kRain;
+    lamp_params =
+        glm::vec4(map ? static_cast<float>(LampRings::kRings) : 0.0f, f.atmosphere.lux_exposure,
+                  static_cast<float>(packed.ego), static_cast<float>(packed.count));
+    if (!map) return;
+    upload_frame_block(f, WaterBlock{});
+    lamp_map->draw(packed.ground_boxes);
+  }
+
   static std::size_t index(Resource r) { return static_cast<std::size_t>(r); }
   std::array<bool, kResourceCount> written{};  // this frame's
 };
@@ -568,10 +611,10 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   glClearDepthf(0.0f);
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
 
-  impl->shared = std::make_unique<SharedResources>(
-      SharedResources{sim::Track::built_in(), upload_repeating(make_noise(256, 1), true),
-                      upload_repeating(make_asphalt_relief(512, 2), true), FullscreenTriangle(),
-                      Texture(), Texture(), 0, nullptr});
+  impl->shared = std::make_unique<SharedResources>(SharedResources{
+      sim::Track::built_in(), upload_repeating(make_noise(256, 1), true),
+      upload_repeating(make_asphalt_relief(512, 2), true), FullscreenTriangle(), Texture(),
+      Texture(), 0, nullptr, sim::street_lights(sim::Track::built_in())});
   upload_reliefs(*impl->shared, relief::road_reliefs(kHorizonDirections));
   glBindTextureUnit(texture_unit::kNoise, impl->shared->noise.id());
   glBindTextureUnit(texture_unit::kAsphalt, impl->shared->asphalt.id());
@@ -582,15 +625,23 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   impl->frame_ubo = Buffer(ubo);
   glNamedBufferStorage(ubo, sizeof(FrameBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
   glBindBufferBase(GL_UNIFORM_BUFFER, kFrameBlockBinding, ubo);
+  GLuint lamp_ubo = 0;
+  glCreateBuffers(1, &lamp_ubo);
+  impl->lamp_ubo = Buffer(lamp_ubo);
+  glNamedBufferStorage(lamp_ubo, sizeof(LampBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLampBlockBinding, lamp_ubo);
+  impl->lamp_map = std::make_unique<LampMap>();
 
   // The views as lists of passes. Nearest first, sky last: llvmpipe tests depth before shading,
   // so what is hidden costs little, and the sky shades only the pixels left empty.
   Pass* cockpit = impl->add<CockpitPass>();
   Pass* vehicles = impl->add<VehiclePass>();
+  Pass* street_lights = impl->add<StreetLightPass>();
   RoadPass* road = impl->add<RoadPass>();
   impl->road = road;
   Pass* terrain = impl->add<TerrainPass>();
   Pass* sky = impl->add<SkyPass>();
+  Pass* glow = impl->add<LampGlowPass>();
   RainPass* rain = impl->add<RainPass>();
   impl->rain = rain;
   Pass* rain_mask = impl->add<RainMaskPass>();
@@ -603,18 +654,18 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   spray->set_smoothing(smoothing);
   impl->passes.push_back(std::make_unique<SprayCompositePass>(*impl->shared, *spray));
   Pass* spray_composite = impl->passes.back().get();
-  impl->reflected = {{vehicles, -0.02f}, {terrain, 0.5f}, {sky, 0.0f}};
+  impl->reflected = {{vehicles, -0.02f}, {street_lights, 0.0f}, {terrain, 0.5f}, {sky, 0.0f}};
   auto& views = impl->views;
   views[static_cast<int>(sim::View::kCockpit)] = {
-      cockpit,         vehicles,         road,        terrain,        sky, rain, spray,
-      spray_composite, glass_background, glass_water, glass_composite};
-  views[static_cast<int>(sim::View::kRoad)] = {vehicles, road,  terrain,        sky,
-                                               rain,     spray, spray_composite};
+      cockpit, vehicles,        street_lights,    road,        terrain,        sky, glow, rain,
+      spray,   spray_composite, glass_background, glass_water, glass_composite};
+  views[static_cast<int>(sim::View::kRoad)] = {vehicles, street_lights, road,  terrain,        sky,
+                                               glow,     rain,          spray, spray_composite};
   views[static_cast<int>(sim::View::kWindshield)] = {windshield};
   // The rain layer alone from the driver's eye: the scene for its depth, then black, then rain and
   // spray.
-  views[static_cast<int>(sim::View::kRain)] = {cockpit,   vehicles, road,  terrain,
-                                               rain_mask, rain,     spray, spray_composite};
+  views[static_cast<int>(sim::View::kRain)] = {
+      cockpit, vehicles, street_lights, road, terrain, rain_mask, rain, spray, spray_composite};
   for (int v = 0; v < sim::kViewCount; ++v) {
     check_pass_order(sim::view_name(static_cast<sim::View>(v)), views[v]);
     for (const Pass* pass : views[v]) {
@@ -637,6 +688,7 @@ void Renderer::set_spray_smoothing(SpraySmoothing smoothing) {
 }
 SpraySmoothing Renderer::spray_smoothing() const { return impl_->spray->smoothing(); }
 void Renderer::set_relief_shadows(bool on) { impl_->road->set_relief_shadows(on); }
+void Renderer::set_lamps(bool on) { impl_->lamps_on = on; }
 bool Renderer::last_drew_relief() const { return impl_->road->drew_relief(); }
 void Renderer::set_spray_cpu_splat(bool cpu) { impl_->spray->set_cpu_splat(cpu); }
 bool Renderer::spray_cpu_splat() const { return impl_->spray->cpu_splat(); }
@@ -712,6 +764,7 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
   const Mirror mirror = mirror_under(m.shared->track, scene.vehicle);
   const bool reflection =
       m.reads_reflection[static_cast<int>(spec.view)] && Impl::road_reflects(frame);
+  m.timed("lamp_map", [&] { m.prepare_lamps(frame); });
   if (reflection) m.timed("road_reflection", [&] { m.draw_reflection(frame, mirror, resources); });
   m.upload_frame_block(frame, Impl::water_block(frame, mirror, reflection));
   glBindFramebuffer(GL_FRAMEBUFFER, target->fbo.id());

@@ -80,6 +80,9 @@ class Renderer {
   // frame drew them (not where the direct sunlight is too faint).
   void set_relief_shadows(bool on);
   bool last_drew_relief() const;
+  // Whether frames light the scene with their lamps (on by default; off for the lights' benchmark:
+  // no lamp map, no lamp in the shaders' loops or the rain; the lit lenses still glow).
+  void set_lamps(bool on);
   // Whether the CPU draws the spray's parcels (llvmpipe's choice) or the GPU.
   void set_spray_cpu_splat(bool cpu);
   bool spray_cpu_splat() const;

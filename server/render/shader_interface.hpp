@@ -40,7 +40,10 @@ namespace downpour::render {
   X(kSetts, 16, sampler2D, setts_tex, "the shoulder's stone setts: rgb normal, a height")          \
   X(kHorizon, 17, sampler2DArray, horizon_tex,                                                     \
     "the reliefs' horizon maps (seed 002), a layer per azimuth k, the asphalt's then the setts': " \
-    "rg tan(beta) and distance at k, ba at k + 1, encoded (relief.hpp)")
+    "rg tan(beta) and distance at k, ba at k + 1, encoded (relief.hpp)")                           \
+  X(kLampMap, 18, sampler2DArray, lamp_map_tex,                                                    \
+    "the lamps' light on the ground in rings around the camera, a layer per ring: rgb the "        \
+    "illuminance of an upward surface times the frame's exposure (lamp_map.hpp)")
 
 // The per-frame uniform block: X(GLSL type, name, comment). Every field is a vec4 or a mat4, so
 // the C++ struct below has the std140 layout as it is.
@@ -64,9 +67,23 @@ namespace downpour::render {
     "w its cell (m)")                                                                         \
   X(vec4, road_water_state,                                                                   \
     "x capacity (mm), y z the window's mean water and standing water "                        \
-    "(mm), w 1 with the window, else 0 (the wetness alone)")
+    "(mm), w 1 with the window, else 0 (the wetness alone)")                                  \
+  X(vec4, lamp_map,                                                                           \
+    "x the lamp map's rings (0: none), y the exposure: radiance per lux, z the ego car's "    \
+    "headlights (first in the lamp block), w all the lamp block's lamps")                     \
+  X(mat4, lamp_rings,                                                                         \
+    "column l: the lamp map's ring l, as road_water_rings: xy lower-left corner, z 1 / "      \
+    "side, w cell (m)")
 
 inline constexpr unsigned kFrameBlockBinding = 0;
+
+// The frame's lamps (light_set.hpp's pack_lamps), a second uniform block: per lamp four vec4s,
+//   [0] xyz position (world), w the height of the ground under it,
+//   [1] xyz the beam's axis (unit), w the cosine of its outer cone (nothing beyond),
+//   [2] rgb luminous intensity on the axis (cd), w the cosine of its inner cone (full within),
+//   [3] x 1 for a dipped beam's cut-off, else 0; yz the beam's left, level (unit).
+inline constexpr unsigned kLampBlockBinding = 1;
+inline constexpr int kMaxLamps = 64;
 
 namespace texture_unit {
 #define DOWNPOUR_UNIT_CONSTANT(name, unit, type, glsl, what) inline constexpr unsigned name = unit;
@@ -85,5 +102,10 @@ struct FrameBlock {
 #undef DOWNPOUR_BLOCK_FIELD
 };
 static_assert(sizeof(FrameBlock) % 16 == 0, "std140: vec4 and mat4 fields only");
+
+struct LampBlock {
+  glm::vec4 count{0.0f};  // x the ego car's headlights, y all the lamps
+  glm::vec4 lamp[4 * kMaxLamps];
+};
 
 }  // namespace downpour::render

@@ -70,6 +70,10 @@ std::string interface_glsl() {
   DOWNPOUR_FRAME_BLOCK(DOWNPOUR_GLSL_FIELD)
 #undef DOWNPOUR_GLSL_FIELD
   s += "} frame;\n";
+  s += "layout(std140, binding = " + std::to_string(kLampBlockBinding) +
+       ") uniform LampBlock {\n  vec4 count;  // x the ego car's headlights, y all the lamps\n"
+       "  vec4 lamp[" +
+       std::to_string(4 * kMaxLamps) + "];  // four per lamp (shader_interface.hpp)\n} lamps;\n";
 #define DOWNPOUR_GLSL_UNIT(name, unit, type, glsl, what)                                      \
   s += std::string("layout(binding = ") + std::to_string(unit) + ") uniform " + #type + " " + \
        #glsl + ";  // " + what + "\n";

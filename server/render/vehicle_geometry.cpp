@@ -1,6 +1,7 @@
 #include "server/render/vehicle_geometry.hpp"
 
 #include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
 
 #include "server/sim/car_body.hpp"
 
@@ -37,9 +38,17 @@ MeshData build_car_upper() {
       m.add_box({x - 0.33f, y - 0.11f, 0.0f}, {x + 0.33f, y + 0.11f, 0.66f}, material::kTyre);
     }
   }
-  // Tail and head lamps.
-  m.add_box({-0.97f, -0.85f, 0.72f}, {-0.93f, -0.55f, 0.85f}, material::kLamp);
-  m.add_box({-0.97f, 0.55f, 0.72f}, {-0.93f, 0.85f, 0.85f}, material::kLamp);
+  // Lamps: tail (and brake) lamps and headlamps, with an indicator beside or under each.
+  for (float side : {1.0f, -1.0f}) {
+    auto y = [side](float a, float b) { return side > 0 ? glm::vec2(a, b) : glm::vec2(-b, -a); };
+    const float indicator = side > 0 ? material::kIndicatorLeft : material::kIndicatorRight;
+    m.add_box({-0.97f, y(0.55f, 0.85f).x, 0.72f}, {-0.93f, y(0.55f, 0.85f).y, 0.85f},
+              material::kLamp);
+    m.add_box({-0.97f, y(0.6f, 0.85f).x, 0.64f}, {-0.93f, y(0.6f, 0.85f).y, 0.71f}, indicator);
+    m.add_box({3.59f, y(0.48f, 0.76f).x, 0.62f}, {3.665f, y(0.48f, 0.76f).y, 0.74f},
+              material::kHeadlamp);
+    m.add_box({3.59f, y(0.77f, 0.86f).x, 0.62f}, {3.665f, y(0.77f, 0.86f).y, 0.7f}, indicator);
+  }
   return m;
 }
 

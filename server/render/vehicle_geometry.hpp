@@ -27,6 +27,10 @@ inline constexpr float kGlass = 1.0f;
 inline constexpr float kTyre = 2.0f;
 inline constexpr float kLamp = 3.0f;
 inline constexpr float kTrim = 4.0f;
+inline constexpr float kHeadlamp = 5.0f;
+inline constexpr float kIndicatorLeft = 6.0f;
+inline constexpr float kIndicatorRight = 7.0f;
+inline constexpr float kStreetLamp = 8.0f;  // a street light's lens (street_light_pass.hpp)
 }  // namespace material
 
 // A passenger car about 4.6 x 1.8 x 1.47 m: the hull (the lower body, whose hood shows from the

@@ -16,10 +16,12 @@ namespace downpour::render {
 // bonnet.
 bool is_driver_view(sim::View view);
 
-// What the rain layer needs of a frame: the camera, the light and haze, the exposure, and what
-// hides the rain (the cars' boxes, kept in `occluders`, which the inputs refer to).
+// What the rain layer needs of a frame: the camera, the light and haze, the exposure, what hides
+// the rain (the cars' boxes, kept in `occluders`) and the lamps that light it (the ego car's
+// headlights, then the strongest others, kept in `lamps`), which the inputs refer to.
 RainLayerInputs rain_layer_inputs(const FrameContext& frame, int layer_height,
-                                  std::vector<RainOccluder>& occluders);
+                                  std::vector<RainOccluder>& occluders,
+                                  std::vector<RainLamp>& lamps);
 
 // Rain in the air (seed 004): the simulation's drops near the car as streaks, their motion relative
 // to the camera during the exposure, in the light around them and faded with distance. They are
@@ -58,6 +60,7 @@ class RainPass final : public Pass {
   ShaderProgram program_;
   Uniform u_plane_depth_;
   std::vector<RainOccluder> occluders_;  // this frame's cars, for the layer
+  std::vector<RainLamp> lamps_;          // and its lamps
   // The layer's tiles that the cabin hides, per driver's camera (cabin_tiles.hpp), the latest few.
   struct CabinTiles {
     int width = 0, height = 0;

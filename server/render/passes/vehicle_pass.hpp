@@ -13,14 +13,15 @@ class VehiclePass final : public Pass {
   void execute(const FrameContext& frame, const FrameResources& resources) override;
 
  private:
-  void draw_car(const glm::mat4& model, const glm::vec3& colour, bool hull_only);
+  void draw_car(const glm::mat4& model, const glm::vec3& colour, const sim::VehicleLights& lights,
+                bool flash_on, bool hull_only);
 
   const PassDecl decl_{"vehicles",
                        {},
                        {Resource::kViewColour, Resource::kViewDepth},
                        {DepthTest::kNearer, true, Blend::kOff}};
   ShaderProgram program_;
-  Uniform u_model_, u_body_colour_;
+  Uniform u_model_, u_body_colour_, u_lamps_, u_head_;
   Mesh hull_;
   Mesh upper_;
 };

@@ -216,3 +216,83 @@ TEST(LightSetTest, TheNightsLoadOverlapsInScreenTiles) {
 
 }  // namespace
 }  // namespace downpour::render
+
+namespace downpour::render {
+namespace {
+
+// What the shaders read: the ego car's beams first, no tail lamps, the lamps ahead of the camera
+// before those behind it, nearest first; each with the box of ground it lights.
+TEST(LightSetTest, PackedLampsPutTheEgoCarsBeamsFirstAndLampsAheadBeforeThoseBehind) {
+  // The camera over the track at 300 m, looking along it; the cars of night_scene elsewhere.
+  const sim::Track& track = sim::Track::built_in();
+  const sim::SceneState s = night_scene();
+  const sim::TrackFrame f = track.at(300.0);
+  const glm::vec3 camera(f.position + glm::dvec3(0.0, 0.0, 1.2));
+  const glm::vec3 forward(std::cos(f.heading_rad), std::sin(f.heading_rad), 0.0f);
+  const std::vector<Light> lights = build_lights(s, sim::street_lights(track), camera);
+  LampBlock block;
+  const PackedLamps packed = pack_lamps(lights, camera, forward, block);
+  EXPECT_EQ(packed.ego, 2);
+  EXPECT_EQ(packed.count, static_cast<int>(lights.size()) - 4) << "all but the two cars' tails";
+  EXPECT_EQ(block.count.x, 2.0f);
+  ASSERT_EQ(packed.ground_boxes.size(), static_cast<std::size_t>(packed.count));
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_NEAR(block.lamp[4 * i].x - s.vehicle.position_m.x, 3.6, 0.01) << "the ego's beams";
+    EXPECT_EQ(block.lamp[4 * i + 3].x, 1.0f) << "dipped";
+  }
+  bool behind_seen = false;
+  float last = 0.0f;
+  for (int i = 2; i < packed.count; ++i) {
+    const glm::vec3 to = glm::vec3(block.lamp[4 * i]) - camera;
+    const bool behind = glm::dot(to, forward) < 0.0f;
+    if (!behind) {
+      EXPECT_FALSE(behind_seen) << "lamp " << i << " ahead after one behind";
+      EXPECT_GE(glm::length(to), last - 1e-3f) << "nearest first";
+      last = glm::length(to);
+    }
+    behind_seen = behind_seen || behind;
+  }
+  EXPECT_TRUE(behind_seen);
+}
+
+// A lamp's footprint holds every point of the ground it gives more than the cut, and little else:
+// a street light's round pool about its foot, a dipped beam's fan ahead of the car.
+TEST(LightSetTest, AFootprintHoldsTheGroundALampLightsAndLittleMore) {
+  sim::SceneState s = night_scene();
+  const std::vector<Light> lights = build_lights(s, {}, glm::vec3(0.0f));
+  Light beam;
+  for (const Light& l : lights) {
+    if (l.kind == LampKind::kHeadlight && l.vehicle == -1) beam = l;
+  }
+  Light street;
+  street.position = {50.0f, 10.0f, 9.0f};
+  street.ground_z = 0.0f;
+  street.direction = {0.0f, 0.0f, -1.0f};
+  street.intensity_cd = glm::vec3(3000.0f);
+  street.cos_inner = std::cos(glm::radians(65.0f));
+  street.cos_outer = std::cos(glm::radians(80.0f));
+  for (const Light& l : {beam, street}) {
+    const glm::vec4 box = lamp_footprint(l, kGroundCutLux);
+    ASSERT_LT(box.x, box.z);
+    int lit = 0;
+    for (float y = -80.0f; y <= 80.0f; y += 0.5f) {
+      for (float x = -80.0f; x <= 80.0f; x += 0.5f) {
+        const glm::vec2 p = glm::vec2(l.position) + glm::vec2(x, y);
+        if (ground_lux(l, p) <= kGroundCutLux) continue;
+        ++lit;
+        EXPECT_TRUE(p.x >= box.x && p.x <= box.z && p.y >= box.y && p.y <= box.w)
+            << "lit at " << x << ", " << y << " outside the box";
+      }
+    }
+    const float area = (box.z - box.x) * (box.w - box.y);
+    std::printf("footprint %.1f x %.1f m, %.0f%% of it lit\n", box.z - box.x, box.w - box.y,
+                100.0f * lit * 0.25f / area);
+    EXPECT_GT(lit * 0.25f, 0.3f * area) << "the box fits the lit ground";
+  }
+  const glm::vec4 fan = lamp_footprint(beam, kGroundCutLux);
+  EXPECT_GT(fan.x, beam.position.x - 1.0f) << "a beam lights the road ahead of the car only";
+  EXPECT_NEAR(ground_lux(street, glm::vec2(50.0f, 10.0f)), 3000.0f / 81.0f, 0.5f) << "under it";
+}
+
+}  // namespace
+}  // namespace downpour::render

@@ -1,0 +1,32 @@
+#pragma once
+
+#include "server/render/chunked_mesh.hpp"
+#include "server/render/pass.hpp"
+
+namespace downpour::render {
+
+// The track's street lights (sim/lights.hpp): a pole on the verge, an arm over the road and a
+// lamp at its end, whose lens glows when the lights are on (their light on the ground is the lamp
+// map's). Static geometry in chunks of ten poles, culled against the view; mirrored in the wet
+// road with the cars.
+class StreetLightPass final : public Pass {
+ public:
+  explicit StreetLightPass(SharedResources& shared);
+  const PassDecl& decl() const override { return decl_; }
+  void execute(const FrameContext& frame, const FrameResources& resources) override;
+
+ private:
+  const PassDecl decl_{"street_lights",
+                       {},
+                       {Resource::kViewColour, Resource::kViewDepth},
+                       {DepthTest::kNearer, true, Blend::kOff}};
+  ShaderProgram program_;
+  Uniform u_head_;
+  ChunkedMesh chunks_;
+};
+
+// The street lights' meshes, ten poles a chunk (one level of detail).
+std::vector<std::vector<MeshData>> build_street_light_chunks(
+    const std::vector<sim::StreetLight>& lights);
+
+}  // namespace downpour::render
