@@ -282,9 +282,20 @@ void main() {
   float resolved = 1.0 - smoothstep(mix(0.01, 0.015, on_setts), mix(0.03, 0.04, on_setts), px);
   lit = mix(lit, relief_lit(l, relief_tex, on_setts * float(u_horizon_directions), relief_h),
             resolved);
+  // At night, the ego car's beams: the relief's shadows seen from between its two headlamps (the
+  // first two of the lamp block), taken from their light here per pixel, which the lamp map holds
+  // unshadowed. (Further off, where the shadows are not resolved, the beams' light stays whole.)
+  vec3 beams = ego_headlights(v_world, n);
+  vec3 to_beams = normalize(0.5 * (lamps.lamp[0].xyz + lamps.lamp[4].xyz) - v_world);
+  vec3 lb = vec3(dot(to_beams, t_lat), dot(to_beams, t_along), dot(to_beams, n_geo));
+  float beams_lit = relief_lit(lb, relief_tex, on_setts * float(u_horizon_directions), relief_h);
+  vec3 beams_shadowed = beams * ((1.0 - beams_lit) * resolved * shadow_shows);
+#else
+  vec3 beams_shadowed = vec3(0.0);
 #endif
   float sun_lit = mix(1.0, lit, shadow_shows);
-  vec3 colour = albedo * (diffuse_light_shadowed(n, sun_lit) + lamp_ground(v_world) * max(n.z, 0.0));
+  vec3 lamps_here = max(lamp_ground(v_world) * max(n.z, 0.0) - beams_shadowed, 0.0);
+  vec3 colour = albedo * (diffuse_light_shadowed(n, sun_lit) + lamps_here);
 
   vec3 n_refl = normalize(mix(mix(n, n_geo, 0.8 * film), n_geo, pool));
 #ifdef ROAD_RIPPLES

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 #include <glm/trigonometric.hpp>
@@ -121,6 +122,42 @@ TEST_F(LightsRenderTest, TheLowBeamsLightTheRainInTheDriversView) {
               beam_off, above_on);
   EXPECT_GT(beam_on, 1.5 * beam_off) << "the beams light the rain they pass through";
   EXPECT_GT(beam_on, 1.5 * above_on) << "brighter in the beams than above their cut-off";
+}
+
+TEST_F(LightsRenderTest, TheReliefCastsShadowsUnderTheLowBeams) {
+  // A camera on a pole 2.5 m over the road ahead of the car and to its right, a narrow lens (20
+  // degrees) looking 55 degrees down at the asphalt 9 m ahead of the headlamps, where the dipped
+  // beams graze it 4 degrees high and give it some 12 lux: the relief's shadows on and off, at
+  // night with the beams on, then off (the street lights alone, nearly overhead, cast none worth
+  // drawing: the road is drawn without them).
+  sim::ViewSpec spec = view_spec(sim::View::kRoad, kWidth, kHeight);
+  sim::CameraPose pose;
+  pose.position_m = {11.0, -2.4, 2.5};
+  pose.rotation.pitch_deg = 55.0;
+  spec.camera = pose;
+  spec.fov_deg = 20.0;
+  const auto shadows_take = [&](sim::Headlights beams) {
+    const sim::SceneState s = night(0.0, beams);
+    const RgbaImage with = render(spec, s);
+    const bool drawn = renderer().last_drew_relief();
+    renderer().set_relief_shadows(false);
+    const RgbaImage without = render(spec, s);
+    renderer().set_relief_shadows(true);
+    if (beams == sim::Headlights::kLow) {
+      save(with, "lights_relief_beams.png");
+      save(without, "lights_relief_beams_off.png");
+    }
+    const double a = testing::mean_luma(with), b = testing::mean_luma(without);
+    std::printf("beams %s: relief drawn %d, luma %.4f with the shadows, %.4f without\n",
+                beams == sim::Headlights::kLow ? "low" : "off", drawn, a, b);
+    return std::pair<bool, double>(drawn, 1.0 - a / b);
+  };
+  const auto [drawn_low, taken_low] = shadows_take(sim::Headlights::kLow);
+  const auto [drawn_off, taken_off] = shadows_take(sim::Headlights::kOff);
+  EXPECT_TRUE(drawn_low);
+  EXPECT_GT(taken_low, 0.02) << "the beams' grazing light leaves the stones' shadows";
+  EXPECT_FALSE(drawn_off);
+  EXPECT_NEAR(taken_off, 0.0, 1e-3);
 }
 
 TEST_F(LightsRenderTest, GoldenNightInTheRain) {

@@ -5,6 +5,7 @@
 
 #include <glm/trigonometric.hpp>
 
+#include "server/render/light_set.hpp"
 #include "server/render/relief.hpp"
 #include "server/render/scene_geometry.hpp"
 
@@ -20,6 +21,9 @@ constexpr float kPuddleFromMm = 0.6f;
 constexpr float kReliefSunFrom = 0.1f;
 // The pixel size (m) beyond which the setts' shadows are their mean (road_surface.glsl).
 constexpr float kSettsResolvedToM = 0.04f;
+// Where the dipped beams come down on the road: about this far ahead of the headlamps (they reach
+// full intensity 10 degrees under their axis, 4 m ahead of a lamp 0.7 m up).
+constexpr float kBeamsReachRoadM = 4.0f;
 
 }  // namespace
 
@@ -72,7 +76,19 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
   const bool ripples = mirror && frame.scene.weather.rain_rate_mm_h > 0.0 && water &&
                        water->max_standing_mm > kPuddleFromMm;
   const glm::vec3& sun = frame.atmosphere.sun_radiance;
-  drew_relief_ = relief_ && std::max({sun.r, sun.g, sun.b}) > kReliefSunFrom;
+  // Shadows under a sun that casts them, or at night under the ego car's beams where the camera
+  // resolves them: the beams reach the road some metres ahead of the car, beyond the near road of
+  // the driver's eye (under the bonnet) and of the chase camera, so those views skip it (it cost
+  // the chase view 2 ms for nothing to see); a camera nearer to them draws it.
+  const float reach = relief_ ? relief_reach_m(frame) : 0.0f;
+  const bool beams =
+      frame.lights && std::any_of(frame.lights->begin(), frame.lights->end(), [&](const Light& l) {
+        if (l.vehicle >= 0 || l.kind != LampKind::kHeadlight) return false;
+        const glm::vec2 ahead = glm::normalize(glm::vec2(l.direction) + glm::vec2(1e-6f, 0.0f));
+        const glm::vec2 lit = glm::vec2(l.position) + ahead * kBeamsReachRoadM;
+        return glm::length(lit - glm::vec2(frame.camera.position)) < reach;
+      });
+  drew_relief_ = relief_ && (std::max({sun.r, sun.g, sun.b}) > kReliefSunFrom || beams);
   const std::size_t plain = ripples ? 2 : mirror ? 1 : 0;
   const glm::mat4 view_proj = frame.camera.projection * frame.camera.view;
   glEnable(GL_CLIP_DISTANCE1);
@@ -80,10 +96,8 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
   // maps on every pixel of one draw, even where a branch skips them). Where a pixel covers many
   // of the relief's texels the shader takes their shadows' mean; the near part ends where that
   // holds everywhere.
-  float reach = 0.0f;
   glm::vec2 mean_lit(1.0f);
   if (drew_relief_) {
-    reach = relief_reach_m(frame);
     const float elevation = std::asin(std::clamp(frame.atmosphere.sun_direction.z, 0.0f, 1.0f));
     mean_lit = {reliefs_->asphalt_horizon.mean_lit(elevation),
                 reliefs_->setts_horizon.mean_lit(elevation)};
@@ -94,7 +108,7 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
   }
   programs_[plain].use();
   mean_lit_[plain].set(mean_lit);
-  near_split_[plain].set(glm::vec2(reach, -1.0f));
+  near_split_[plain].set(glm::vec2(drew_relief_ ? reach : 0.0f, -1.0f));
   chunks_.draw_visible(view_proj, frame.camera.position);
   glDisable(GL_CLIP_DISTANCE1);
 }
