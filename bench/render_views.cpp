@@ -212,6 +212,13 @@ int main(int argc, char** argv) {
     simulation.advance(t);
   }
   sim::SceneState scene = simulation.state();
+  if (spray_drive && update.weather) {
+    // The drive keeps its own weather; the sky's options apply to the picture.
+    scene.weather.sun_altitude_deg = update.weather->sun_altitude_deg;
+    scene.weather.sun_azimuth_deg = update.weather->sun_azimuth_deg;
+    scene.weather.cloudiness = update.weather->cloudiness;
+    scene.weather.fog_density = update.weather->fog_density;
+  }
   if (windshield_metaballs == 0) {
     scene.windshield = testing::golden_windshield(scene.glass);
   } else if (windshield_metaballs > 0) {

@@ -62,6 +62,23 @@ vec3 lamp_ground(vec3 p) {
   return mix(coarse * in1, fine, in0) * step(0.5, frame.lamp_map.x);
 }
 
+// The lamps' light that water in the air at p scatters towards the eye (to_eye: unit, from p):
+// the ego car's beams and the two lamps after them in the lamp block (the nearest ahead), through
+// a drop's rough phase function, as rain_layer.cpp's (much forwards, some back, little sideways);
+// as radiance.
+vec3 lamps_scattered(vec3 p, vec3 to_eye) {
+  vec3 e = vec3(0.0);
+  int n = min(int(lamps.count.y), int(lamps.count.x) + 2);
+  for (int i = 0; i < n; ++i) {
+    vec3 from_lamp = normalize(p - lamps.lamp[4 * i].xyz);
+    float c = dot(from_lamp, to_eye);
+    float fwd = max(c, 0.0), back = max(-c, 0.0);
+    float f2 = fwd * fwd, f4 = f2 * f2;
+    e += lamp_lux(i, p, -from_lamp) * (0.06 + 0.3 * back * back + 2.0 * f4 * f4);
+  }
+  return e * frame.lamp_map.y;
+}
+
 // The ego car's headlights on a surface at p with normal n, per pixel (the first lamps of the
 // block), as radiance per unit albedo.
 vec3 ego_headlights(vec3 p, vec3 n) {

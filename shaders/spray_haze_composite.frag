@@ -1,11 +1,12 @@
 #version 450
-// The haze over the spray layer: the light the droplets scatter times their coverage
+// The haze over the spray layer: the light the droplets scatter (the sky's and the scene's, and
+// the lamps' where their beams pass) times their coverage
 // 1 - exp(-tau), faded where the scene lies nearer than the cloud's mean distance (soft
 // particles, over u_soft_m), the haze map softened by four bilinear taps a texel apart (a parcel
 // stands for a cloud whose edge is not sharp). Premultiplied.
 #include "common.glsl"
 in vec2 v_uv;
-uniform vec3 u_light;  // display-encoded
+uniform vec3 u_light;  // linear: the sky's and the scene's
 uniform float u_near;
 uniform float u_soft_m;
 out vec4 out_colour;
@@ -19,5 +20,11 @@ void main() {
   float z = h.y / h.x;
   float scene = u_near / max(textureLod(view_depth_tex, v_uv, 0.0).r, 1e-12);
   float alpha = (1.0 - exp(-h.x)) * clamp((scene - z) / u_soft_m + 0.5, 0.0, 1.0);
-  out_colour = vec4(u_light * alpha, alpha);
+  // And the lamps' (a beam through the mist glows), at the cloud's mean distance along the ray.
+  vec4 far = frame.inv_view_proj * vec4(v_uv * 2.0 - 1.0, 0.5, 1.0);
+  vec4 centre = frame.inv_view_proj * vec4(0.0, 0.0, 0.5, 1.0);
+  vec3 dir = normalize(far.xyz / far.w - frame.camera_pos.xyz);
+  vec3 ahead = normalize(centre.xyz / centre.w - frame.camera_pos.xyz);
+  vec3 p = frame.camera_pos.xyz + dir * (z / max(dot(dir, ahead), 0.1));
+  out_colour = vec4(to_display(u_light + lamps_scattered(p, -dir)) * alpha, alpha);
 }

@@ -118,6 +118,10 @@ void main() {
   float through = 1.0, path = 0.0;
   vec3 p = dir * ((first == 0 ? body : spray) / -dir.z);
   int object = first;
+  // The lamps' light that the water scatters towards the eye where it enters (a beam lights the
+  // spray in it; the droplets' many faces scatter it every way, as the rain's drops do).
+  vec3 to_world = mat3(u_view_to_world) * p;
+  colour += 0.5 * lamps_scattered(frame.camera_pos.xyz + to_world, -normalize(to_world));
   for (int k = 0; k < 2; ++k) {
     // In at the front.
     vec3 n = front_normal(object, ivec2(pixel_of(p)), -p.z);

@@ -229,6 +229,33 @@ TEST_F(SprayRenderTest, RoadShowsMistBehindTheTruckOnADrenchedRoad) {
   }
 }
 
+// At night the spray behind the truck glows in the ego car's dipped beams: from the driver's seat,
+// the spray in the beams (the lower middle of the view, over the road between the car and the
+// truck) is brighter with them than without, by more than the road under it.
+TEST_F(SprayRenderTest, TheBeamsLightTheSprayAtNight) {
+  const sim::ViewSpec spec = view_spec(sim::View::kCockpit, 320, 180);
+  const int x0 = 120, x1 = 200, y0 = 80, y1 = 100;
+  sim::SceneState scene = behind_truck(1.0);
+  scene.weather.sun_altitude_deg = -20.0;
+  scene.weather.fog_density = 0.0;
+  scene.rain.drops.clear();
+  scene.rain.splashes.clear();
+  const auto lit = [&](sim::Headlights beams, bool spray) {
+    sim::SceneState s = scene;
+    s.ego_lights.headlights = beams;
+    if (!spray) s.spray.reset();
+    return testing::mean_luma(render(spec, s), x0, y0, x1, y1);
+  };
+  const double spray_on = lit(sim::Headlights::kLow, true),
+               spray_off = lit(sim::Headlights::kOff, true);
+  const double road_on = lit(sim::Headlights::kLow, false),
+               road_off = lit(sim::Headlights::kOff, false);
+  std::printf("with the spray: luma %.3f in the beams, %.3f without; the road alone %.3f, %.3f\n",
+              spray_on, spray_off, road_on, road_off);
+  EXPECT_GT(spray_on - spray_off, 0.05);
+  EXPECT_GT(spray_on - spray_off, road_on - road_off) << "the spray catches the beams";
+}
+
 // Spray behind a truck on a road with puddles, from the chase camera and from the driver's seat
 // (dry glass, so that the spray is what is seen).
 TEST_F(SprayRenderTest, GoldenSprayBehindATruck) {

@@ -459,14 +459,14 @@ void SprayPass::execute(const FrameContext& frame, const FrameResources& resourc
     haze_map(frame, t);
     // The light the droplets scatter: the sky's and the scene's around them, as the rain's.
     const Atmosphere& atm = frame.atmosphere;
+    // (Linear: the shader adds the lamps' light where their beams pass, then encodes it.)
     const glm::vec3 light =
         glm::mix(atm.sky_horizon, atm.ambient, 0.4f) * 0.95f + atm.sun_radiance * 0.05f;
-    const glm::vec3 shown = glm::sqrt(glm::clamp(light / (1.0f + 0.15f * light), 0.0f, 1.0f));
     glBindFramebuffer(GL_FRAMEBUFFER, resources.spray_layer_fbo);
     glViewport(0, 0, width, height);
     glBindTextureUnit(texture_unit::kSprayHaze, t.haze.id());
     haze_composite_program_.use();
-    u_haze_light_.set(shown);
+    u_haze_light_.set(light);
     u_haze_near_.set(camera.near_m);
     u_haze_soft_.set(kHazeSoftM);
     apply(RenderState{DepthTest::kOff, false, Blend::kPremultiplied});
