@@ -134,10 +134,7 @@ float beam_towards(const Light& l, const glm::vec3& dir, float stray) {
     glm::vec2 left(-l.direction.y, l.direction.x);
     const float len = glm::length(left);
     left = len > 1e-4f ? left / len : glm::vec2(1.0f, 0.0f);
-    // (As common.glsl's lamp_lux: 0.6 degrees under the horizon, rising at 15 on the nearside.)
-    const float limit = -0.0105f + 0.268f * std::max(-glm::dot(glm::vec2(dir), left), 0.0f);
-    const float u = std::clamp((limit + 0.006f - dir.z) / 0.012f, 0.0f, 1.0f);
-    beam *= stray + (1.0f - stray) * u * u * (3.0f - 2.0f * u);
+    beam *= stray + (1.0f - stray) * dipped_cut(-glm::dot(glm::vec2(dir), left), dir.z);
   }
   return beam;
 }

@@ -5,6 +5,7 @@
 // colour channel; the shader turns lux into its radiance with the frame's exposure. No GL.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -91,6 +92,24 @@ struct PackedLamps {
 // Below this a lamp's light on the ground is left out (the lamp map draws E - kGroundCutLux), so
 // that each lamp draws only its footprint: 1 lux shows at night as 1/150 of white on asphalt.
 inline constexpr float kGroundCutLux = 1.0f;
+// A dipped beam's cut-off (right-hand traffic), for a unit direction from the lamp whose component
+// to the beam's right is `right` and whose upward one is `up`: 1 under the line (0.6 degrees below
+// the horizon towards the oncoming lanes, rising at 15 degrees on the nearside), 0 over it,
+// smoothed over +-0.006; as common.glsl's lamp_lux.
+inline float dipped_cut(float right, float up) {
+  const float limit = -0.0105f + 0.268f * std::max(right, 0.0f);
+  const float u = std::clamp((limit + 0.006f - up) / 0.012f, 0.0f, 1.0f);
+  return u * u * (3.0f - 2.0f * u);
+}
+// What share of the light on a water drop it sends on at a scattering angle of cosine c, roughly:
+// most forwards (an oncoming lamp's halo), some back (a beam from behind the eye), little
+// sideways (a street lamp overhead); as common.glsl's lamps_scattered.
+inline float drop_phase(float c) {
+  const float fwd = std::max(c, 0.0f), back = std::max(-c, 0.0f);
+  const float f2 = fwd * fwd, f4 = f2 * f2;
+  return 0.06f + 0.3f * back * back + 2.0f * f4 * f4;
+}
+
 // The share of a lamp's intensity on its axis that it sends along the unit direction `dir`: its
 // cones, and a dipped beam's cut-off, above which it leaves `stray` of it.
 float beam_towards(const Light& light, const glm::vec3& dir, float stray = 0.0f);

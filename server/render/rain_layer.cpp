@@ -10,6 +10,7 @@
 #include <glm/matrix.hpp>
 
 #include "server/render/cabin_tiles.hpp"
+#include "server/render/light_set.hpp"
 
 namespace downpour::render {
 
@@ -258,8 +259,6 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
   };
   // The lamps' light on a drop at p (camera frame), in levels (Texel::lit).
   const std::size_t lamp_count = std::min(in.lamps.size(), RainLayerInputs::kMaxLamps);
-  // A drop's phase function, roughly: water drops send most of a beam on forwards (an oncoming
-  // lamp's halo), some back (a beam from behind the camera), little sideways (a street lamp above).
   auto lamp_level = [&](const glm::vec3& p) -> std::uint32_t {
     float radiance = 0.0f;
     const glm::vec3 to_camera = -p / std::max(glm::length(p), 1e-3f);
@@ -272,15 +271,8 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
                                      std::max(lamp.cos_inner - lamp.cos_outer, 1e-4f),
                                  0.0f, 1.0f);
       float beam = t * t * (3.0f - 2.0f * t);
-      if (lamp.low_beam) {
-        const float limit = -0.0105f + 0.268f * std::max(-glm::dot(l, lamp.left), 0.0f);
-        if (glm::dot(l, in.up) > limit) beam = 0.0f;
-      }
-      const float c = glm::dot(l, to_camera);
-      const float fwd = std::max(c, 0.0f), back = std::max(-c, 0.0f);
-      const float f2 = fwd * fwd, f4 = f2 * f2;
-      const float phase = 0.06f + 0.3f * back * back + 2.0f * f4 * f4;
-      radiance += lamp.intensity * phase * beam / d2;
+      if (lamp.low_beam) beam *= dipped_cut(-glm::dot(l, lamp.left), glm::dot(l, in.up));
+      radiance += lamp.intensity * drop_phase(glm::dot(l, to_camera)) * beam / d2;
     }
     const float level = std::sqrt(std::min(radiance / kLitMax, 1.0f)) * (kLitLevels - 1);
     return static_cast<std::uint32_t>(level + 0.5f);

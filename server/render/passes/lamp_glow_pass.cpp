@@ -9,10 +9,9 @@
 
 namespace downpour::render {
 
-std::vector<LampGlow> lamp_glows(const std::vector<Light>& lights, const glm::vec3& camera,
-                                 float tan_half_fov_y, int height, float lux_exposure,
-                                 float haze_per_m) {
-  std::vector<LampGlow> glows;
+void lamp_glows(const std::vector<Light>& lights, const glm::vec3& camera, float tan_half_fov_y,
+                int height, float lux_exposure, float haze_per_m, std::vector<LampGlow>& glows) {
+  glows.clear();
   const float pixels_per_radian = 0.5f * static_cast<float>(height) / tan_half_fov_y;
   for (const Light& l : lights) {
     const glm::vec3 to_camera = camera - l.position;
@@ -44,7 +43,6 @@ std::vector<LampGlow> lamp_glows(const std::vector<Light>& lights, const glm::ve
                       });
     glows.resize(kMaxGlows);
   }
-  return glows;
 }
 
 LampGlowPass::LampGlowPass(SharedResources&)
@@ -61,9 +59,10 @@ bool LampGlowPass::wanted(const FrameContext& frame) const {
 }
 
 void LampGlowPass::execute(const FrameContext& frame, const FrameResources& resources) {
-  const std::vector<LampGlow> glows = lamp_glows(
-      *frame.lights, frame.camera.position, frame.camera.tan_half_fov_y,
-      resources.view_colour.height, frame.atmosphere.lux_exposure, frame.atmosphere.fog_density);
+  lamp_glows(*frame.lights, frame.camera.position, frame.camera.tan_half_fov_y,
+             resources.view_colour.height, frame.atmosphere.lux_exposure,
+             frame.atmosphere.fog_density, glows_);
+  const std::vector<LampGlow>& glows = glows_;
   if (glows.empty()) return;
   packed_.clear();
   for (const LampGlow& g : glows) {

@@ -25,11 +25,11 @@ struct LampGlow {
 
 // The glows of the frame's lamps seen from `camera` in a view `height` pixels high with the
 // vertical half-angle tan_half_fov_y, under the frame's exposure (radiance per lux) and haze
-// (extinction per metre); at most kMaxGlows, the strongest.
+// (extinction per metre); at most kMaxGlows, the strongest. Into `glows` (cleared first: kept
+// from frame to frame, no allocation once it has grown).
 inline constexpr std::size_t kMaxGlows = 96;
-std::vector<LampGlow> lamp_glows(const std::vector<Light>& lights, const glm::vec3& camera,
-                                 float tan_half_fov_y, int height, float lux_exposure,
-                                 float haze_per_m);
+void lamp_glows(const std::vector<Light>& lights, const glm::vec3& camera, float tan_half_fov_y,
+                int height, float lux_exposure, float haze_per_m, std::vector<LampGlow>& glows);
 
 class LampGlowPass final : public Pass {
  public:
@@ -44,6 +44,7 @@ class LampGlowPass final : public Pass {
   ShaderProgram program_;
   Uniform u_glows_, u_pixel_;
   VertexArray vao_;
+  std::vector<LampGlow> glows_;
   std::vector<glm::vec4> packed_;
 };
 

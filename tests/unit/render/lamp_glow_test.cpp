@@ -2,6 +2,7 @@
 // one that points away or cuts its beam off under the camera hardly does; the rings lie ahead of
 // the camera on whole cells.
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <glm/trigonometric.hpp>
@@ -13,7 +14,7 @@
 namespace downpour::render {
 namespace {
 
-Light beam_towards(float x, bool dipped) {
+Light oncoming_beam(float x, bool dipped) {
   Light l;
   l.position = {x, 0.0f, 0.7f};
   const float down = glm::radians(dipped ? 1.0f : 0.0f);
@@ -30,10 +31,11 @@ TEST(LampGlowTest, ABeamAtTheCameraGlaresAndOneCutOffOrTurnedAwayHardlyDoes) {
   const float tan_half = std::tan(glm::radians(25.0f));
   // An oncoming car 60 m off on high beam, then on low beam (the eye above its cut-off), then a
   // car ahead driving away, all at night's exposure.
-  Light away = beam_towards(60.0f, true);
+  Light away = oncoming_beam(60.0f, true);
   away.direction = -away.direction;
-  const auto glows = lamp_glows({beam_towards(60.0f, false), beam_towards(60.0f, true), away}, eye,
-                                tan_half, 360, 0.05f, 0.0f);
+  std::vector<LampGlow> glows;
+  lamp_glows({oncoming_beam(60.0f, false), oncoming_beam(60.0f, true), away}, eye, tan_half, 360,
+             0.05f, 0.0f, glows);
   ASSERT_EQ(glows.size(), 2u) << "a lamp pointing away shows no lens";
   const LampGlow& high = glows[0];
   const LampGlow& low = glows[1];
@@ -44,7 +46,8 @@ TEST(LampGlowTest, ABeamAtTheCameraGlaresAndOneCutOffOrTurnedAwayHardlyDoes) {
   EXPECT_GT(low.core, 0.9f);
   EXPECT_LT(glm::length(glm::vec3(high.position_size) - eye), 60.0f) << "towards the camera";
   // Fog takes the glare with distance.
-  const auto fogged = lamp_glows({beam_towards(60.0f, false)}, eye, tan_half, 360, 0.05f, 0.03f);
+  std::vector<LampGlow> fogged;
+  lamp_glows({oncoming_beam(60.0f, false)}, eye, tan_half, 360, 0.05f, 0.03f, fogged);
   EXPECT_LT(fogged[0].colour_strength.w, 0.25f * high.colour_strength.w);
 }
 
