@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
         renderer->finish(renderer->render(*session, 0, spec, scene), pixels);
       };
       const bench::Added added = bench::added_to_frames(
-          frames, kWarmUp, [&] { frame(true); }, [&] { frame(false); });
+          frames, 3 * kWarmUp, [&] { frame(true); }, [&] { frame(false); });
       row["frame_ms"] = added.frame_ms;
       row["lights_in_frame_ms"] = added.added_ms;
       row["ceiling_ms"] = 3.0;

@@ -20,8 +20,9 @@ inline double percentile(std::vector<double> v, double p) {
 inline double median(std::vector<double> v) { return percentile(std::move(v), 0.5); }
 
 // What one thing adds to whole frames: `frames` pairs of frames, one with it (with(), wall time)
-// and one without (without()), drawn in turn after `warm_up` pairs, so that a machine whose speed
-// drifts affects both alike. The median of the pairs' differences, and of the frames with it.
+// and one without (without()), drawn in turn after `warm_up` pairs, which first alternating, so
+// that a machine whose speed drifts, or a frame that slows the next, affects both alike. The median
+// of the pairs' differences, and of the frames with it.
 struct Added {
   double added_ms = 0.0;
   double frame_ms = 0.0;
@@ -31,7 +32,8 @@ Added added_to_frames(int frames, int warm_up, With&& with, Without&& without) {
   std::vector<double> added, whole;
   for (int i = 0; i < frames + warm_up; ++i) {
     double ms[2];
-    for (int k = 0; k < 2; ++k) {
+    for (int j = 0; j < 2; ++j) {
+      const int k = (i + j) % 2;  // which goes first alternates: a frame after the other's
       const auto t0 = std::chrono::steady_clock::now();
       if (k == 0) {
         with();

@@ -6,7 +6,8 @@
 // sky in its lower part and road in its upper part over the horizon. The refracted ray looks up
 // the scene behind (a blurred copy) where it stays in the image, else the sky. Seen from inside,
 // the surface reflects the dark cabin (Fresnel, from the water side); where it leans most the rays
-// graze it and the rims darken; the sun, where a drop bends it into the eye, glints.
+// graze it and the rims darken; the sun, where a drop bends it into the eye, glints. At night the
+// drops around a bright lamp bend its light into the eye: each holds a bright point of it.
 #include "common.glsl"
 in vec2 v_glass_mm;
 in vec3 v_world;
@@ -23,14 +24,31 @@ uniform float u_fresnel_r0;
 uniform float u_rim_darkening;
 uniform vec2 u_rim_lean;  // the lean where rims start to darken and where they are darkest
 uniform float u_glint;    // the sun seen through a drop, relative to its direct light
+uniform int u_lamp_count;
+uniform vec4 u_lamps[16];  // per lamp: the unit direction towards it and the radiance its drops
+                           // show (display units); its colour
+uniform vec2 u_lamp_spread;  // cosines: full out to x from the lamp, none past y
 
-// The light reaching the eye through the water at a glass point (premultiplied by its coverage).
-vec4 through_water(vec2 glass_mm, vec2 view_uv, vec3 view) {
+// The light of the lamps that the water bends into the eye along `view` (per unit of coverage).
+vec3 lamps_through_drops(vec3 view) {
+  vec3 light = vec3(0.0);
+  for (int i = 0; i < u_lamp_count; ++i) {
+    float c = dot(view, u_lamps[2 * i].xyz);
+    light += u_lamps[2 * i + 1].rgb * (u_lamps[2 * i].w * smoothstep(u_lamp_spread.y, u_lamp_spread.x, c));
+  }
+  return light;
+}
+
+// The light reaching the eye through the water at a glass point (premultiplied by its coverage);
+// `curved` gains the coverage of curved water there (a drop's, not a flat film's: only a leaning
+// surface bends the lamps around into the eye).
+vec4 through_water(vec2 glass_mm, vec2 view_uv, vec3 view, inout float curved) {
   vec4 water = textureLod(glass_water_tex, glass_mm / u_map_size_mm, 0.0);
   float wet = water.a;
   if (wet < 0.002) return vec4(0.0);  // dry glass here
   vec2 n = water.xy * 2.0 - 1.0;  // glass-parallel part of the surface normal
   float lean = min(length(n), 1.0);  // sine of the surface's tilt
+  curved += wet * smoothstep(0.05, 0.3, lean);
   float bend = asin(min(u_water_ior * lean, 1.0)) - asin(lean);
   vec2 towards = lean > 1e-4 ? n / lean : vec2(0.0);
   float deflect = tan(bend);
@@ -55,19 +73,22 @@ vec4 through_water(vec2 glass_mm, vec2 view_uv, vec3 view) {
 void main() {
   vec3 view = normalize(v_world - frame.camera_pos.xyz);
   vec2 view_uv = gl_FragCoord.xy * u_inv_target;
+  float curved = 0.0;
   if (u_taps == 1) {
-    out_colour = through_water(v_glass_mm, view_uv, view);
+    out_colour = through_water(v_glass_mm, view_uv, view, curved);
     if (out_colour.a < 0.002) discard;
+    if (u_lamp_count > 0) out_colour.rgb += lamps_through_drops(view) * curved;
     return;
   }
   // The lens blurs what the eye sees through the water, not the water's shape: the optics at
   // 2 x 2 points of the pixel, averaged (the layer's magnification then blurs further).
   vec2 dx = 0.25 * dFdx(v_glass_mm), dy = 0.25 * dFdy(v_glass_mm);
   vec2 ux = 0.25 * u_inv_target * vec2(1.0, 0.0), uy = 0.25 * u_inv_target * vec2(0.0, 1.0);
-  vec4 sum = through_water(v_glass_mm - dx - dy, view_uv - ux - uy, view) +
-             through_water(v_glass_mm + dx - dy, view_uv + ux - uy, view) +
-             through_water(v_glass_mm - dx + dy, view_uv - ux + uy, view) +
-             through_water(v_glass_mm + dx + dy, view_uv + ux + uy, view);
+  vec4 sum = through_water(v_glass_mm - dx - dy, view_uv - ux - uy, view, curved) +
+             through_water(v_glass_mm + dx - dy, view_uv + ux - uy, view, curved) +
+             through_water(v_glass_mm - dx + dy, view_uv - ux + uy, view, curved) +
+             through_water(v_glass_mm + dx + dy, view_uv + ux + uy, view, curved);
   if (sum.a < 0.008) discard;
   out_colour = 0.25 * sum;
+  if (u_lamp_count > 0) out_colour.rgb += lamps_through_drops(view) * (0.25 * curved);
 }

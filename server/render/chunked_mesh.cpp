@@ -8,8 +8,8 @@
 namespace downpour::render {
 
 ChunkedMesh::ChunkedMesh(const std::vector<std::vector<MeshData>>& chunks,
-                         std::vector<float> level_distances_m)
-    : level_distances_m_(std::move(level_distances_m)) {
+                         std::vector<float> level_distances_m, float max_distance_m)
+    : level_distances_m_(std::move(level_distances_m)), max_distance_m_(max_distance_m) {
   chunks_.reserve(chunks.size());
   for (const std::vector<MeshData>& levels : chunks) {
     Chunk c;
@@ -33,6 +33,7 @@ void ChunkedMesh::for_each_visible(const glm::mat4& view_proj, const glm::vec3& 
     const float distance =
         glm::length(glm::clamp(camera, chunk.bounds_min, chunk.bounds_max) - camera) *
         distance_scale;
+    if (distance >= max_distance_m_) continue;
     std::size_t level = 0;
     while (level < level_distances_m_.size() && level + 1 < chunk.levels.size() &&
            distance >= level_distances_m_[level]) {

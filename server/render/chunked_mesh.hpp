@@ -15,9 +15,9 @@ namespace downpour::render {
 class ChunkedMesh {
  public:
   // chunks[c][level]: level 0 the finest. A chunk is drawn at level k when its nearest point is
-  // at least level_distances_m[k - 1] from the camera.
+  // at least level_distances_m[k - 1] from the camera, and not at all from max_distance_m on.
   ChunkedMesh(const std::vector<std::vector<MeshData>>& chunks,
-              std::vector<float> level_distances_m);
+              std::vector<float> level_distances_m, float max_distance_m = 1e30f);
   // Draws the chunks whose bounds meet the view's frustum with the bound program, each at the
   // level for its distance times distance_scale.
   void draw_visible(const glm::mat4& view_proj, const glm::vec3& camera,
@@ -37,6 +37,7 @@ class ChunkedMesh {
   };
   std::vector<Chunk> chunks_;
   std::vector<float> level_distances_m_;
+  float max_distance_m_;
 };
 
 }  // namespace downpour::render

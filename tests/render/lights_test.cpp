@@ -61,6 +61,29 @@ class LightsRenderTest : public testing::RenderTest {
     EXPECT_TRUE(x >= 2 && x < kWidth - 2 && y >= 2 && y < kHeight - 2) << x << ", " << y;
     return testing::mean_luma(image, x - 2, y - 2, x + 3, y + 3);
   }
+  // A car on the track `ahead_m` along it from the ego car, `lateral_m` left of its centre line,
+  // driving with the traffic or against it.
+  static sim::TrafficVehicle car(const sim::SceneState& s, std::uint32_t id, double ahead_m,
+                                 double lateral_m, bool oncoming) {
+    const sim::Track& track = sim::Track::built_in();
+    const double s0 = track.project(glm::dvec2(s.vehicle.position_m), 50.0).s;
+    const sim::TrackFrame f = track.at(s0 + ahead_m);
+    sim::TrafficVehicle v;
+    v.id = id;
+    const glm::dvec2 xy = glm::dvec2(f.position) + f.left * lateral_m;
+    v.state.position_m = {xy.x, xy.y, track.surface_height(s0 + ahead_m, lateral_m)};
+    v.state.rotation.yaw_deg = glm::degrees(f.heading_rad) + (oncoming ? 180.0 : 0.0);
+    v.size_m = {4.6, 1.8, 1.47};
+    return v;
+  }
+  // The screen pixel (column, row top-down) where a world point shows.
+  static glm::ivec2 pixel_of(const sim::ViewSpec& spec, const sim::SceneState& s,
+                             glm::dvec3 world) {
+    const Camera camera = make_camera(spec, s.vehicle);
+    const glm::vec4 clip = camera.projection * camera.view * glm::vec4(glm::vec3(world), 1.0f);
+    return {static_cast<int>((clip.x / clip.w * 0.5f + 0.5f) * spec.width),
+            static_cast<int>((0.5f - clip.y / clip.w * 0.5f) * spec.height)};
+  }
   static void save(const RgbaImage& image, const std::string& name) {
     if (const char* dir = std::getenv("DOWNPOUR_TEST_IMAGES")) {
       testing::write_png(std::string(dir) + "/" + name, image);
@@ -160,24 +183,62 @@ TEST_F(LightsRenderTest, TheReliefCastsShadowsUnderTheLowBeams) {
   EXPECT_NEAR(taken_off, 0.0, 1e-3);
 }
 
+TEST_F(LightsRenderTest, TheLampsBloomThroughTheWetGlass) {
+  // An oncoming car on high beam 45 m off, seen from the driver's seat at night through a
+  // windshield beaded with rain (the golden windshield's water) and through the same glass dry,
+  // its lamps on and off. Each drop is a small lens with a wide field: the drops around the
+  // lamps' image show bright points of them. Counted, for each glass: the pixels that the lamps
+  // make brighter by 0.1 near them (8 to 40 px from them, 2 to 11 degrees) and far from them
+  // (beyond 120 px, 34 degrees, where no drop bends them into the eye).
+  sim::SceneState s = night(0.0, sim::Headlights::kLow);
+  const sim::Track& track = sim::Track::built_in();
+  s.traffic = {car(s, 1, 45.0, -track.lane_centre(0), true)};
+  sim::VehicleLights high;
+  high.headlights = sim::Headlights::kHigh;
+  s.traffic_lights = {high};
+  const sim::ViewSpec spec = view_spec(sim::View::kCockpit, kWidth, kHeight);
+  const glm::dvec3 front =
+      glm::dvec3(sim::vehicle_to_world(s.traffic[0].state) * glm::dvec4(3.6, 0.0, 0.7, 1.0));
+  const glm::ivec2 lamp = pixel_of(spec, s, front);
+  struct Lit {
+    int near = 0, far = 0;
+  };
+  const auto lit_by_the_lamps = [&](bool wet, const std::string& name) {
+    sim::SceneState on = s;
+    if (wet) on.windshield = testing::golden_windshield(on.glass);
+    sim::SceneState off = on;
+    off.traffic_lights[0].headlights = sim::Headlights::kOff;
+    const RgbaImage a = render(spec, on), b = render(spec, off);
+    save(a, name + "_on.png");
+    save(b, name + "_off.png");
+    Lit lit;
+    for (int y = 0; y < kHeight; ++y) {
+      for (int x = 0; x < kWidth; ++x) {
+        const int r2 = (x - lamp.x) * (x - lamp.x) + (y - lamp.y) * (y - lamp.y);
+        const double d =
+            testing::mean_luma(a, x, y, x + 1, y + 1) - testing::mean_luma(b, x, y, x + 1, y + 1);
+        if (d <= 0.1) continue;
+        if (r2 >= 8 * 8 && r2 <= 40 * 40) ++lit.near;
+        if (r2 > 120 * 120) ++lit.far;
+      }
+    }
+    std::printf("%s glass, the lamps at (%d, %d): %d pixels lit near them, %d far off\n",
+                wet ? "wet" : "dry", lamp.x, lamp.y, lit.near, lit.far);
+    return lit;
+  };
+  const Lit wet = lit_by_the_lamps(true, "lights_bloom_wet");
+  const Lit dry = lit_by_the_lamps(false, "lights_bloom_dry");
+  EXPECT_GT(wet.near, 3 * dry.near + 20) << "the drops around the lamps show points of them";
+  EXPECT_EQ(wet.far, 0) << "and none far from them";
+}
+
 TEST_F(LightsRenderTest, GoldenNightInTheRain) {
   // 10 mm/h at night from the driver's seat: the low beams, a car braking 25 m ahead in the lane
   // to the left, one oncoming 70 m off, the street lights; the road wet from the weather.
   sim::SceneState s = night(10.0, sim::Headlights::kLow);
   const sim::Track& track = sim::Track::built_in();
-  const double s0 = track.project(glm::dvec2(s.vehicle.position_m), 50.0).s;
-  auto car = [&](std::uint32_t id, double ahead_m, double lateral_m, bool oncoming) {
-    const sim::TrackFrame f = track.at(s0 + ahead_m);
-    sim::TrafficVehicle v;
-    v.id = id;
-    const glm::dvec2 xy = glm::dvec2(f.position) + f.left * lateral_m;
-    v.state.position_m = {xy.x, xy.y, track.surface_height(s0 + ahead_m, lateral_m)};
-    v.state.rotation.yaw_deg = glm::degrees(f.heading_rad) + (oncoming ? 180.0 : 0.0);
-    v.size_m = {4.6, 1.8, 1.47};
-    return v;
-  };
-  s.traffic = {car(1, 25.0, track.lane_centre(0), false),
-               car(2, 70.0, -track.lane_centre(0), true)};
+  s.traffic = {car(s, 1, 25.0, track.lane_centre(0), false),
+               car(s, 2, 70.0, -track.lane_centre(0), true)};
   sim::VehicleLights braking;
   braking.headlights = sim::Headlights::kLow;
   braking.brake = true;

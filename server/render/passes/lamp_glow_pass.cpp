@@ -9,23 +9,30 @@
 
 namespace downpour::render {
 
+float lamp_glare(const Light& l, const glm::vec3& camera, float lux_exposure, float haze_per_m,
+                 glm::vec3* dir_out, float* distance) {
+  const glm::vec3 to_camera = camera - l.position;
+  const float d = std::max(glm::length(to_camera), 0.3f);
+  const glm::vec3 dir = to_camera / d;
+  if (dir_out) *dir_out = dir;
+  if (distance) *distance = d;
+  // A lens shows from anywhere within its outer cone.
+  const float peak = std::max({l.intensity_cd.r, l.intensity_cd.g, l.intensity_cd.b});
+  if (glm::dot(dir, l.direction) <= l.cos_outer || peak <= 0.0f) return 0.0f;
+  return peak * beam_towards(l, dir, 0.03f) / (d * d) * lux_exposure * std::exp(-haze_per_m * d);
+}
+
 void lamp_glows(const std::vector<Light>& lights, const glm::vec3& camera, float tan_half_fov_y,
                 int height, float lux_exposure, float haze_per_m, std::vector<LampGlow>& glows) {
   glows.clear();
   const float pixels_per_radian = 0.5f * static_cast<float>(height) / tan_half_fov_y;
   for (const Light& l : lights) {
-    const glm::vec3 to_camera = camera - l.position;
-    const float d = std::max(glm::length(to_camera), 0.3f);
-    const glm::vec3 dir = to_camera / d;
-    // The lamp's intensity towards the camera: its beam, a dipped beam's cut-off leaving 3% stray
-    // light above the line; a lens shows from anywhere within its outer cone.
-    const float cos_axis = glm::dot(dir, l.direction);
-    const float beam = beam_towards(l, dir, 0.03f);
+    glm::vec3 dir;
+    float d = 0.0f;
+    const float glare = lamp_glare(l, camera, lux_exposure, haze_per_m, &dir, &d);
     const float peak = std::max({l.intensity_cd.r, l.intensity_cd.g, l.intensity_cd.b});
-    if (cos_axis <= l.cos_outer || peak <= 0.0f) continue;
+    if (glm::dot(dir, l.direction) <= l.cos_outer || peak <= 0.0f) continue;
     const float haze = std::exp(-haze_per_m * d);
-    // The glare: the illuminance at the camera, as the radiance a white card there would show.
-    const float glare = peak * beam / (d * d) * lux_exposure * haze;
     LampGlow g;
     // The halo: half a degree across at a glare of 0.1, growing with its square root.
     const float radius = pixels_per_radian * 0.00873f * std::sqrt(glare / 0.1f);

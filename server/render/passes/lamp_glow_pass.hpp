@@ -23,6 +23,14 @@ struct LampGlow {
   float core = 0.0f;                // the core's brightness: 1 for a lens that faces the camera
 };
 
+// A lamp's glare at `camera`: the illuminance it gives there (its beam towards the camera, a
+// dipped beam leaving 3% stray light above its cut-off, through the haze), as the radiance a
+// white card there would show (display units, the frame's exposure per lux); 0 for a lamp that
+// points away. `dir` (if given) receives the unit direction from the lamp to the camera, and
+// `distance` the distance.
+float lamp_glare(const Light& light, const glm::vec3& camera, float lux_exposure, float haze_per_m,
+                 glm::vec3* dir = nullptr, float* distance = nullptr);
+
 // The glows of the frame's lamps seen from `camera` in a view `height` pixels high with the
 // vertical half-angle tan_half_fov_y, under the frame's exposure (radiance per lux) and haze
 // (extinction per metre); at most kMaxGlows, the strongest. Into `glows` (cleared first: kept

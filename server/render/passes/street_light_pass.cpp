@@ -26,7 +26,7 @@ void add_oriented_box(MeshData& m, const glm::vec3& centre, const glm::vec3& alo
 
 std::vector<std::vector<MeshData>> build_street_light_chunks(
     const std::vector<sim::StreetLight>& lights) {
-  constexpr std::size_t kPerChunk = 10;
+  constexpr std::size_t kPerChunk = 4;
   std::vector<std::vector<MeshData>> chunks;
   for (std::size_t first = 0; first < lights.size(); first += kPerChunk) {
     MeshData m;
@@ -54,7 +54,7 @@ std::vector<std::vector<MeshData>> build_street_light_chunks(
 StreetLightPass::StreetLightPass(SharedResources& shared)
     : program_("mesh.vert", "vehicle.frag"),
       u_head_(program_.uniform("u_head")),
-      chunks_(build_street_light_chunks(shared.street_lights), {}) {
+      chunks_(build_street_light_chunks(shared.street_lights), {}, kStreetLightsDrawnWithin_m) {
   program_.uniform("u_model").set(glm::mat4(1.0f));
   program_.uniform("u_body_colour").set(glm::vec3(0.3f, 0.31f, 0.32f));
   program_.uniform("u_lamps").set(glm::vec4(0.0f));

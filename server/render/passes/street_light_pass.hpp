@@ -7,8 +7,10 @@ namespace downpour::render {
 
 // The track's street lights (sim/lights.hpp): a pole on the verge, an arm over the road and a
 // lamp at its end, whose lens glows when the lights are on (their light on the ground is the lamp
-// map's). Static geometry in chunks of ten poles, culled against the view; mirrored in the wet
-// road with the cars.
+// map's). Static geometry in chunks of four poles, culled against the view and beyond
+// kStreetLightsDrawnWithin_m (a pole there is a fifth of a pixel wide at 640 x 360; at night the
+// lamp_glow pass still draws its lens); mirrored in the wet road with the cars.
+inline constexpr float kStreetLightsDrawnWithin_m = 350.0f;
 class StreetLightPass final : public Pass {
  public:
   explicit StreetLightPass(SharedResources& shared);
@@ -25,7 +27,7 @@ class StreetLightPass final : public Pass {
   ChunkedMesh chunks_;
 };
 
-// The street lights' meshes, ten poles a chunk (one level of detail).
+// The street lights' meshes, four poles a chunk (one level of detail).
 std::vector<std::vector<MeshData>> build_street_light_chunks(
     const std::vector<sim::StreetLight>& lights);
 
