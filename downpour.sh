@@ -17,7 +17,7 @@ PY=/usr/bin/python3  # Debian's interpreter, with python3-grpcio
 
 PACKAGES=(cmake ninja-build g++ pkg-config
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
-  libturbojpeg0-dev libspdlog-dev libglm-dev libcli11-dev nlohmann-json3-dev libpng-dev
+  libturbojpeg0-dev libspdlog-dev libglm-dev libcli11-dev nlohmann-json3-dev libpng-dev libpugixml-dev
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   libgtest-dev libgmock-dev libbenchmark-dev glslang-tools
   python3 python3-grpcio python3-protobuf python3-pil openssl)
@@ -121,12 +121,12 @@ fuzz() {
   local dir="$ROOT/build-fuzz"
   CXX=clang++-14 CC=clang-14 cmake -S "$ROOT" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DDOWNPOUR_FUZZ=ON -DDOWNPOUR_BUILD_TESTS=OFF -DDOWNPOUR_BUILD_BENCH=OFF >/dev/null
-  cmake --build "$dir" -j "$(nproc)" --target request_fuzzer scenario_fuzzer simulation_fuzzer
+  cmake --build "$dir" -j "$(nproc)" --target request_fuzzer scenario_fuzzer simulation_fuzzer opendrive_fuzzer
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-  # All three at once (libFuzzer runs one process each); a crash leaves its input as
+  # All four at once (libFuzzer runs one process each); a crash leaves its input as
   # build-fuzz/<target>-crash-* and fails the run.
   local pids=() target
-  for target in request scenario simulation; do
+  for target in request scenario simulation opendrive; do
     local work="$dir/corpus/$target" extra=()
     mkdir -p "$work"
     [ "$target" = scenario ] && extra=("$ROOT/clients/scenarios")
@@ -136,7 +136,7 @@ fuzz() {
     pids+=($!)
   done
   local failed=0 i=0
-  for target in request scenario simulation; do
+  for target in request scenario simulation opendrive; do
     if wait "${pids[$i]}"; then
       echo "fuzz $target: $(grep -E '^stat::number_of_executed_units' "$dir/$target.log" |
         awk '{print $2}') inputs in $seconds s, no crash"

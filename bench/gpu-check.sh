@@ -28,7 +28,7 @@ if [ ! -x "$BENCH" ]; then
     echo "missing build tools: ${missing[*]}; trying apt-get (this machine may be offline)"
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
       cmake ninja-build g++ pkg-config libturbojpeg0-dev libspdlog-dev libglm-dev libcli11-dev \
-      nlohmann-json3-dev libpng-dev libegl-dev libgl-dev libopengl-dev >/dev/null || {
+      nlohmann-json3-dev libpng-dev libpugixml-dev libegl-dev libgl-dev libopengl-dev >/dev/null || {
       echo "cannot install the build tools: copy a built downpour-bench here (DOWNPOUR_BENCH)"
       exit 2
     }
