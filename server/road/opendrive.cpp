@@ -170,7 +170,34 @@ double Road::lane_border(double s, int lane_id) const {
   return t;
 }
 
-double Road::surface_height(double s, double t) const { return height(s) + t * std::tan(roll(s)); }
+double Road::surface_height(double s, double t) const {
+  double z = height(s) + t * std::tan(roll(s));
+  if (sections.empty()) return z;
+  const LaneSection& section = section_at(s);
+  const double ds = s - section.s;
+  const std::vector<Lane>& side = t >= lane_offset(s) ? section.left : section.right;
+  const int sign = t >= lane_offset(s) ? 1 : -1;
+  // The lane t lies in, from the centre outwards (or the outermost one).
+  double inner = lane_offset(s);
+  for (std::size_t i = 0; i < side.size(); ++i) {
+    const double outer = lane_border(s, sign * static_cast<int>(i + 1));
+    const bool last = i + 1 == side.size();
+    if (!last && (t - outer) * sign > 0.0) {
+      inner = outer;
+      continue;
+    }
+    const auto& heights = side[i].heights;
+    const auto it = std::upper_bound(heights.begin(), heights.end(), ds,
+                                     [](double v, const LaneHeight& h) { return v < h.s_offset; });
+    if (it == heights.begin()) break;
+    const LaneHeight& h = *std::prev(it);
+    const double width = std::abs(outer - inner);
+    const double f = width > 1e-9 ? std::clamp(std::abs(t - inner) / width, 0.0, 1.0) : 1.0;
+    z += h.inner + (h.outer - h.inner) * f;
+    break;
+  }
+  return z;
+}
 
 const Road* Network::find_road(std::string_view id) const {
   for (const Road& r : roads) {
@@ -431,6 +458,17 @@ class Parser {
     if (node.child("border"))
       fail(node.child("border"), "lane borders are not supported (widths are)");
     lane.widths = cubics(node, "width", "sOffset");
+    for (const pugi::xml_node h : node.children("height")) {
+      count_record(h);
+      LaneHeight height;
+      height.s_offset = non_negative(h, "sOffset", 0.0);
+      height.inner = number(h, "inner", 0.0);
+      height.outer = number(h, "outer", 0.0);
+      if (!lane.heights.empty() && height.s_offset < lane.heights.back().s_offset) {
+        fail(h, "sOffset goes backwards");
+      }
+      lane.heights.push_back(height);
+    }
     for (const pugi::xml_node m : node.children("roadMark")) {
       count_record(m);
       RoadMark mark;

@@ -66,10 +66,19 @@ struct RoadMark {
   double width = 0.12;    // metres
 };
 
+// A lane's surface raised over the road's (superelevated) reference plane, at its inner and outer
+// borders, linear between them: a crowned road's fall towards its edges, a raised sidewalk.
+struct LaneHeight {
+  double s_offset = 0.0;  // from the lane section's start
+  double inner = 0.0;
+  double outer = 0.0;
+};
+
 struct Lane {
   int id = 0;                 // > 0 left of the centre lane, < 0 right, 0 the centre lane itself
   std::string type;           // driving, shoulder, border, sidewalk, median, ...
   std::vector<Cubic> widths;  // s: offset from the lane section's start
+  std::vector<LaneHeight> heights;
   std::vector<RoadMark> marks;
   // The lane's own links, where given (0: none).
   int predecessor = 0, successor = 0;
@@ -111,7 +120,8 @@ struct Road {
   // lane's offset itself. Lanes missing from the section at s count zero width.
   double lane_border(double s, int lane_id) const;
   // The height of the road surface at (s, t): the reference line's elevation tilted by the
-  // superelevation about it.
+  // superelevation about it, and the lane's height there (beyond the outermost lane, its outer
+  // border's).
   double surface_height(double s, double t) const;
 };
 

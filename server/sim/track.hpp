@@ -31,6 +31,23 @@ class Track {
   // The same, made once and shared (sessions, the renderer's stats, test fixtures).
   static const Track& built_in();
 
+  // The centreline's pieces, in order around the loop: straights and arcs.
+  struct Segment {
+    double s0 = 0.0;
+    double length = 0.0;
+    double curvature = 0.0;  // 1/m, left positive; 0 = straight
+    glm::dvec2 start{0.0};
+    double heading0 = 0.0;
+  };
+  // Hills: z = height (1 + cos(pi u)) / 2, u = (s - s_centre) / half_length in (-1, 1).
+  struct Crest {
+    double s_centre = 0.0;
+    double half_length = 0.0;
+    double height = 0.0;
+  };
+  const std::vector<Segment>& segments() const { return segments_; }
+  const std::vector<Crest>& crests() const { return crests_; }
+
   double length() const { return length_; }
   const CrossSection& cross_section() const { return section_; }
   double paved_half_width() const;  // lanes and shoulders
@@ -57,19 +74,6 @@ class Track {
   Projection project_near(glm::dvec2 xy, double s_guess) const;
 
  private:
-  struct Segment {
-    double s0 = 0.0;
-    double length = 0.0;
-    double curvature = 0.0;  // 1/m, left positive; 0 = straight
-    glm::dvec2 start{0.0};
-    double heading0 = 0.0;
-  };
-  struct Crest {
-    double s_centre = 0.0;
-    double half_length = 0.0;
-    double height = 0.0;
-  };
-
   double wrap(double s) const;
   double elevation(double s) const;
   double elevation_grade(double s) const;
