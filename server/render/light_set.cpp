@@ -12,6 +12,7 @@
 
 #include "server/render/shader_interface.hpp"
 #include "server/sim/pose.hpp"
+#include "server/sim/vehicle_class.hpp"
 
 namespace downpour::render {
 namespace {
@@ -26,11 +27,11 @@ float range_for(const glm::vec3& intensity_cd, float cutoff_lux) {
   return std::sqrt(peak / std::max(cutoff_lux, 1e-6f));
 }
 
-// One vehicle's lit lamps. to_world: its frame to the world; scale: its size against the ego
-// car's.
-void add_vehicle(const glm::dmat4& to_world, const glm::vec3& scale, const sim::VehicleLights& lit,
-                 bool flash_on, std::int32_t index, const LightSetConfig& c,
-                 std::vector<Light>& out) {
+// One vehicle's lit lamps. to_world: its frame to the world; scale: its size against its
+// class's shape; head, tail: its left headlamp and tail lamp on that shape (y = 0: one of each).
+void add_vehicle(const glm::dmat4& to_world, const glm::vec3& scale, const glm::vec3& head_m,
+                 const glm::vec3& tail_m, const sim::VehicleLights& lit, bool flash_on,
+                 std::int32_t index, const LightSetConfig& c, std::vector<Light>& out) {
   const glm::mat4 m(to_world);
   const glm::vec3 forward = glm::normalize(glm::vec3(m[0])), up = glm::normalize(glm::vec3(m[2]));
   auto lamp = [&](glm::vec3 at, glm::vec3 dir, glm::vec3 cd, float inner_deg, float outer_deg,
@@ -50,8 +51,9 @@ void add_vehicle(const glm::dmat4& to_world, const glm::vec3& scale, const sim::
   const bool heads =
       lit.headlights == sim::Headlights::kLow || lit.headlights == sim::Headlights::kHigh;
   for (float side : {1.0f, -1.0f}) {
-    const glm::vec3 head(c.headlamp_m.x, c.headlamp_m.y * side, c.headlamp_m.z);
-    const glm::vec3 tail(c.tail_lamp_m.x, c.tail_lamp_m.y * side, c.tail_lamp_m.z);
+    if (side < 0.0f && head_m.y == 0.0f) break;  // a single lamp each way
+    const glm::vec3 head(head_m.x, head_m.y * side, head_m.z);
+    const glm::vec3 tail(tail_m.x, tail_m.y * side, tail_m.z);
     if (lit.headlights == sim::Headlights::kLow) {
       const float down = glm::radians(c.low_beam_down_deg);
       lamp(head, forward * std::cos(down) - up * std::sin(down), kHeadlightWhite * c.low_beam_cd,
@@ -90,15 +92,20 @@ std::vector<Light> build_lights(const sim::SceneState& scene,
                                 const glm::vec3& camera_m, const LightSetConfig& c) {
   std::vector<Light> out;
   const bool flash_on = sim::indicator_lit(scene.sim_time_s);
-  add_vehicle(sim::vehicle_to_world(scene.vehicle), glm::vec3(1.0f),
+  add_vehicle(sim::vehicle_to_world(scene.vehicle), glm::vec3(1.0f), c.headlamp_m, c.tail_lamp_m,
               shown_lights(scene.ego_lights, scene.weather), flash_on, -1, c, out);
   for (std::size_t i = 0; i < scene.traffic.size(); ++i) {
     const sim::TrafficVehicle& t = scene.traffic[i];
-    const glm::vec3 scale(t.size_m.x / 4.6, t.size_m.y / 1.8, t.size_m.z / 1.47);
+    const sim::VehicleLayout& layout = sim::vehicle_layout(t.vehicle_class);
+    // A car's lamps as the ego car's (the config's); the other classes' from their layouts.
+    const bool car = t.vehicle_class == sim::VehicleClass::kCar;
     const sim::VehicleLights lights =
         i < scene.traffic_lights.size() ? scene.traffic_lights[i] : sim::VehicleLights{};
-    add_vehicle(sim::vehicle_to_world(t.state), scale, shown_lights(lights, scene.weather),
-                flash_on, static_cast<std::int32_t>(i), c, out);
+    add_vehicle(sim::vehicle_to_world(t.state), glm::vec3(sim::layout_scale(t)),
+                car ? c.headlamp_m : glm::vec3(layout.headlamp_m),
+                car ? c.tail_lamp_m : glm::vec3(layout.tail_lamp_m),
+                shown_lights(lights, scene.weather), flash_on, static_cast<std::int32_t>(i), c,
+                out);
   }
   if (sim::street_lights_on(scene.weather)) {
     std::vector<std::pair<float, std::size_t>> near;

@@ -1,9 +1,12 @@
 #include "server/render/vehicle_geometry.hpp"
 
+#include <initializer_list>
+
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 
 #include "server/sim/car_body.hpp"
+#include "server/sim/vehicle_class.hpp"
 
 namespace downpour::render {
 
@@ -49,6 +52,95 @@ MeshData build_car_upper() {
               material::kHeadlamp);
     m.add_box({3.59f, y(0.77f, 0.86f).x, 0.62f}, {3.665f, y(0.77f, 0.86f).y, 0.7f}, indicator);
   }
+  return m;
+}
+
+namespace {
+
+// Lamps at the front (x = front) and back (x = rear) of a wide vehicle: a headlamp with an
+// indicator outboard of it, a tail lamp with an indicator under it, each side; centred on the
+// layout's lamp positions.
+void add_lamps(MeshData& m, const sim::VehicleLayout& l, float front) {
+  for (float side : {1.0f, -1.0f}) {
+    const float indicator = side > 0 ? material::kIndicatorLeft : material::kIndicatorRight;
+    const auto hy = static_cast<float>(l.headlamp_m.y), hz = static_cast<float>(l.headlamp_m.z);
+    const auto ty = static_cast<float>(l.tail_lamp_m.y), tz = static_cast<float>(l.tail_lamp_m.z);
+    const auto rear = static_cast<float>(l.rear_m);
+    const auto span = [side](float a, float b) {
+      return side > 0 ? glm::vec2(a, b) : glm::vec2(-b, -a);
+    };
+    m.add_box({front - 0.04f, span(hy - 0.15f, hy + 0.15f).x, hz - 0.08f},
+              {front + 0.02f, span(hy - 0.15f, hy + 0.15f).y, hz + 0.08f}, material::kHeadlamp);
+    m.add_box({front - 0.04f, span(hy + 0.17f, hy + 0.25f).x, hz - 0.06f},
+              {front + 0.02f, span(hy + 0.17f, hy + 0.25f).y, hz + 0.06f}, indicator);
+    m.add_box({rear - 0.02f, span(ty - 0.12f, ty + 0.12f).x, tz - 0.1f},
+              {rear + 0.04f, span(ty - 0.12f, ty + 0.12f).y, tz + 0.1f}, material::kLamp);
+    m.add_box({rear - 0.02f, span(ty - 0.12f, ty + 0.12f).x, tz - 0.22f},
+              {rear + 0.04f, span(ty - 0.12f, ty + 0.12f).y, tz - 0.12f}, indicator);
+  }
+}
+
+void add_wheels(MeshData& m, std::initializer_list<float> axles, float half_track, float radius,
+                float width) {
+  for (float x : axles) {
+    for (float y : {-half_track, half_track}) {
+      m.add_box({x - radius, y - 0.5f * width, 0.0f}, {x + radius, y + 0.5f * width, 2.0f * radius},
+                material::kTyre);
+    }
+  }
+}
+
+}  // namespace
+
+MeshData build_truck() {
+  const sim::VehicleLayout& l = sim::vehicle_layout(sim::VehicleClass::kTruck);
+  MeshData m;
+  const float front = static_cast<float>(l.rear_m + l.size_m.x);  // 9.0
+  // Chassis rails, the cab (its lower part body, its windows glass, a roof) and the box body.
+  m.add_box({-3.0f, -0.5f, 0.55f}, {front - 0.3f, 0.5f, 1.0f}, material::kTrim);
+  m.add_box({front - 2.3f, -1.25f, 0.45f}, {front, 1.25f, 1.9f}, material::kBody);
+  m.add_frustum({front - 2.3f, -1.22f, 1.9f}, {front - 0.05f, 1.22f, 2.75f}, {front - 2.3f, -1.2f},
+                {front - 0.25f, 1.2f}, material::kGlass);
+  m.add_box({front - 2.3f, -1.24f, 2.75f}, {front - 0.2f, 1.24f, 3.2f}, material::kBody);
+  m.add_box({-3.0f, -1.25f, 1.0f}, {front - 2.45f, 1.25f, 3.8f}, material::kBody);
+  add_wheels(m, {-0.65f, 0.65f, 7.5f}, 1.0f, 0.5f, 0.4f);
+  add_lamps(m, l, front);
+  return m;
+}
+
+MeshData build_bus() {
+  const sim::VehicleLayout& l = sim::vehicle_layout(sim::VehicleClass::kBus);
+  MeshData m;
+  const float front = static_cast<float>(l.rear_m + l.size_m.x);  // 8.6
+  const float half = static_cast<float>(0.5 * l.size_m.y);
+  // A box: the lower body, a band of windows (the windscreen down to 1 m at the front), the roof.
+  m.add_box({-3.4f, -half, 0.3f}, {front, half, 1.15f}, material::kBody);
+  m.add_box({-3.4f, -half + 0.02f, 1.15f}, {front - 0.02f, half - 0.02f, 2.7f}, material::kGlass);
+  m.add_box({-3.4f, -half, 2.7f}, {front, half, 3.2f}, material::kBody);
+  m.add_box({-3.4f, -half - 0.01f, 1.15f}, {-2.6f, half + 0.01f, 2.7f}, material::kBody);  // back
+  add_wheels(m, {0.0f, 6.0f}, 1.0f, 0.5f, 0.3f);
+  add_lamps(m, l, front);
+  return m;
+}
+
+MeshData build_motorbike() {
+  const sim::VehicleLayout& l = sim::vehicle_layout(sim::VehicleClass::kMotorbike);
+  MeshData m;
+  // Two wheels 1.45 m apart, the tank and seat between, forks; the rider sitting up, helmeted.
+  add_wheels(m, {0.0f, 1.45f}, 0.0f, 0.32f, 0.14f);
+  m.add_box({0.05f, -0.17f, 0.45f}, {1.25f, 0.17f, 0.9f}, material::kBody);
+  m.add_box({1.2f, -0.08f, 0.4f}, {1.5f, 0.08f, 1.0f}, material::kTrim);
+  m.add_box({0.3f, -0.2f, 0.9f}, {0.7f, 0.2f, 1.35f}, material::kTrim);      // rider's body
+  m.add_box({0.6f, -0.3f, 1.05f}, {1.2f, 0.3f, 1.15f}, material::kTrim);     // arms to the bars
+  m.add_box({0.38f, -0.14f, 1.35f}, {0.66f, 0.14f, 1.6f}, material::kBody);  // helmet
+  const auto hx = static_cast<float>(l.headlamp_m.x), hz = static_cast<float>(l.headlamp_m.z);
+  const auto tx = static_cast<float>(l.tail_lamp_m.x), tz = static_cast<float>(l.tail_lamp_m.z);
+  m.add_box({hx - 0.12f, -0.09f, hz - 0.08f}, {hx, 0.09f, hz + 0.08f}, material::kHeadlamp);
+  m.add_box({tx, -0.08f, tz - 0.05f}, {tx + 0.08f, 0.08f, tz + 0.05f}, material::kLamp);
+  m.add_box({tx, 0.1f, tz - 0.03f}, {tx + 0.05f, 0.18f, tz + 0.03f}, material::kIndicatorLeft);
+  m.add_box({tx, -0.18f, tz - 0.03f}, {tx + 0.05f, -0.1f, tz + 0.03f}, material::kIndicatorRight);
+  m.add_box({0.0f, -0.1f, 0.6f}, {0.2f, 0.1f, 0.8f}, material::kTrim);  // the tail
+  m.add_box({tx, -0.08f, tz - 0.1f}, {0.05f, 0.08f, tz - 0.02f}, material::kTrim);
   return m;
 }
 

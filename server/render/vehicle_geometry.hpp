@@ -37,6 +37,11 @@ inline constexpr float kStreetLamp = 8.0f;  // a street light's lens (street_lig
 // driver's seat) and the rest (cabin, roof, wheels, lamps).
 MeshData build_car_hull();
 MeshData build_car_upper();
+// The other classes' shapes at their usual sizes (sim/vehicle_class.hpp), whole: a rigid truck
+// (cab, box body, wheels), a city bus (body, window band), a motorbike with its rider.
+MeshData build_truck();
+MeshData build_bus();
+MeshData build_motorbike();
 // Dashboard, A-pillars, roof edge and mirror as seen from the driver's seat.
 MeshData build_cockpit_interior(const sim::GlassConfig& glass);
 // Whether two glasses give the same cockpit interior (the fields it is built from).

@@ -4,6 +4,8 @@
 #include <set>
 #include <sstream>
 
+#include "server/sim/vehicle_class.hpp"
+
 namespace downpour::rpc {
 namespace {
 
@@ -179,6 +181,25 @@ grpc::Status to_update(const v1::Update& in, const std::string& field, const Lim
       sim::TrafficVehicle v;
       v.id = t.id();
       DP_RETURN_IF_ERROR(to_vehicle(t.state(), tf + ".state", &v.state));
+      switch (t.vehicle_class()) {
+        case v1::VEHICLE_CLASS_UNSPECIFIED:
+        case v1::VEHICLE_CLASS_CAR:
+          v.vehicle_class = sim::VehicleClass::kCar;
+          break;
+        case v1::VEHICLE_CLASS_TRUCK:
+          v.vehicle_class = sim::VehicleClass::kTruck;
+          break;
+        case v1::VEHICLE_CLASS_BUS:
+          v.vehicle_class = sim::VehicleClass::kBus;
+          break;
+        case v1::VEHICLE_CLASS_MOTORBIKE:
+          v.vehicle_class = sim::VehicleClass::kMotorbike;
+          break;
+        default:
+          return invalid(tf + ".vehicle_class",
+                         "unknown class " + std::to_string(t.vehicle_class()));
+      }
+      v.size_m = sim::vehicle_layout(v.vehicle_class).size_m;
       if (t.has_size_m()) {
         glm::dvec3 size;
         DP_RETURN_IF_ERROR(to_vec3(t.size_m(), 30.0, tf + ".size_m", &size));

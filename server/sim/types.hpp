@@ -58,10 +58,14 @@ struct Weather {
   double rain_angle_deg = 0.0;
 };
 
+// What a traffic vehicle is: its shape and where its lamps sit (vehicle_class.hpp).
+enum class VehicleClass : std::uint8_t { kCar, kTruck, kBus, kMotorbike };
+
 struct TrafficVehicle {
   std::uint32_t id = 0;
   VehicleState state;
   glm::dvec3 size_m{4.5, 1.8, 1.5};
+  VehicleClass vehicle_class = VehicleClass::kCar;
 };
 
 // The road's state under a point (road_water.hpp).

@@ -153,12 +153,8 @@ TEST_F(LightsRenderTest, TheReliefCastsShadowsUnderTheLowBeams) {
   // beams graze it 4 degrees high and give it some 12 lux: the relief's shadows on and off, at
   // night with the beams on, then off (the street lights alone, nearly overhead, cast none worth
   // drawing: the road is drawn without them).
-  sim::ViewSpec spec = view_spec(sim::View::kRoad, kWidth, kHeight);
-  sim::CameraPose pose;
-  pose.position_m = {11.0, -2.4, 2.5};
-  pose.rotation.pitch_deg = 55.0;
-  spec.camera = pose;
-  spec.fov_deg = 20.0;
+  const sim::ViewSpec spec =
+      posed_view(sim::View::kRoad, kWidth, kHeight, {11.0, -2.4, 2.5}, 0.0, 55.0, 20.0);
   const auto shadows_take = [&](sim::Headlights beams) {
     const sim::SceneState s = night(0.0, beams);
     const RgbaImage with = render(spec, s);

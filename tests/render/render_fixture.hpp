@@ -24,6 +24,19 @@ class RenderTest : public ::testing::Test {
   static sim::ViewSpec view_spec(sim::View view, int width, int height) {
     return sim::view_spec(view, width, height);
   }
+  // A view from a camera of its own: at `position` in the ego car's frame, turned by yaw and
+  // pitch (degrees; pitch positive looks down), with a vertical field of view of fov_deg.
+  static sim::ViewSpec posed_view(sim::View view, int width, int height, glm::dvec3 position,
+                                  double yaw_deg, double pitch_deg, double fov_deg) {
+    sim::ViewSpec spec = sim::view_spec(view, width, height);
+    sim::CameraPose pose;
+    pose.position_m = position;
+    pose.rotation.yaw_deg = yaw_deg;
+    pose.rotation.pitch_deg = pitch_deg;
+    spec.camera = pose;
+    spec.fov_deg = fov_deg;
+    return spec;
+  }
   static RgbaImage render(const sim::ViewSpec& spec, const sim::SceneState& scene) {
     return {spec.width, spec.height, render::render_image(*renderer_, spec, scene)};
   }

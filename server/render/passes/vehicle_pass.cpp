@@ -1,10 +1,13 @@
 #include "server/render/passes/vehicle_pass.hpp"
 
+#include <algorithm>
+
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "server/render/light_set.hpp"
 #include "server/render/vehicle_geometry.hpp"
 #include "server/sim/pose.hpp"
+#include "server/sim/vehicle_class.hpp"
 
 namespace downpour::render {
 
@@ -15,10 +18,13 @@ VehiclePass::VehiclePass(SharedResources&)
       u_lamps_(program_.uniform("u_lamps")),
       u_head_(program_.uniform("u_head")),
       hull_(build_car_hull()),
-      upper_(build_car_upper()) {}
+      upper_(build_car_upper()),
+      truck_(build_truck()),
+      bus_(build_bus()),
+      motorbike_(build_motorbike()) {}
 
-void VehiclePass::draw_car(const glm::mat4& model, const glm::vec3& colour,
-                           const sim::VehicleLights& lights, bool flash_on, bool hull_only) {
+void VehiclePass::prepare(const glm::mat4& model, const glm::vec3& colour,
+                          const sim::VehicleLights& lights, bool flash_on) {
   u_model_.set(model);
   u_body_colour_.set(colour);
   const bool heads =
@@ -28,8 +34,6 @@ void VehiclePass::draw_car(const glm::mat4& model, const glm::vec3& colour,
                          lights.left_indicator ? flash : 0.0f,
                          lights.right_indicator ? flash : 0.0f));
   u_head_.set(lights.headlights == sim::Headlights::kHigh ? 2.0f : heads ? 1.0f : 0.0f);
-  hull_.draw();
-  if (!hull_only) upper_.draw();
 }
 
 void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
@@ -39,23 +43,45 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
       frame.spec.view == sim::View::kCockpit || frame.spec.view == sim::View::kRain;
   const bool flash_on = sim::indicator_lit(frame.scene.sim_time_s);
   const sim::Weather& weather = frame.scene.weather;
-  draw_car(frame.vehicle_to_world, glm::vec3(0.42f, 0.05f, 0.04f),
-           shown_lights(frame.scene.ego_lights, weather), flash_on, cockpit);
+  prepare(frame.vehicle_to_world, glm::vec3(0.42f, 0.05f, 0.04f),
+          shown_lights(frame.scene.ego_lights, weather), flash_on);
+  hull_.draw();
+  if (!cockpit) upper_.draw();
   const glm::mat4 view_proj = frame.camera.projection * frame.camera.view;
   static const glm::vec3 palette[] = {{0.75f, 0.75f, 0.78f}, {0.05f, 0.06f, 0.08f},
                                       {0.1f, 0.2f, 0.45f},   {0.55f, 0.55f, 0.5f},
                                       {0.35f, 0.02f, 0.02f}, {0.9f, 0.9f, 0.88f}};
   for (std::size_t i = 0; i < frame.scene.traffic.size(); ++i) {
     const sim::TrafficVehicle& other = frame.scene.traffic[i];
-    // The car shape is 4.6 x 1.8 x 1.47 m from the rear axle; scale it to the reported size.
-    const glm::vec3 scale(other.size_m.x / 4.6, other.size_m.y / 1.8, other.size_m.z / 1.47);
-    const glm::mat4 model = glm::scale(glm::mat4(sim::vehicle_to_world(other.state)), scale);
-    const glm::vec3 centre = glm::vec3(model * glm::vec4(1.35f, 0.0f, 0.7f, 1.0f));
-    if (!box_visible(view_proj, centre - glm::vec3(4.0f), centre + glm::vec3(4.0f))) continue;
+    // The class's shape at its usual size, scaled to the reported one.
+    const sim::VehicleLayout& layout = sim::vehicle_layout(other.vehicle_class);
+    const glm::mat4 model = glm::scale(glm::mat4(sim::vehicle_to_world(other.state)),
+                                       glm::vec3(sim::layout_scale(other)));
+    const glm::vec3 centre =
+        glm::vec3(model * glm::vec4(glm::vec3(layout.rear_m + 0.5 * layout.size_m.x, 0.0,
+                                              0.5 * layout.size_m.z),
+                                    1.0f));
+    const float reach = 0.6f * static_cast<float>(std::max(other.size_m.x, other.size_m.z));
+    if (!box_visible(view_proj, centre - glm::vec3(reach), centre + glm::vec3(reach))) continue;
     const sim::VehicleLights lights = i < frame.scene.traffic_lights.size()
                                           ? frame.scene.traffic_lights[i]
                                           : sim::VehicleLights{};
-    draw_car(model, palette[other.id % 6], shown_lights(lights, weather), flash_on, false);
+    prepare(model, palette[other.id % 6], shown_lights(lights, weather), flash_on);
+    switch (other.vehicle_class) {
+      case sim::VehicleClass::kTruck:
+        truck_.draw();
+        break;
+      case sim::VehicleClass::kBus:
+        bus_.draw();
+        break;
+      case sim::VehicleClass::kMotorbike:
+        motorbike_.draw();
+        break;
+      case sim::VehicleClass::kCar:
+        hull_.draw();
+        upper_.draw();
+        break;
+    }
   }
 }
 

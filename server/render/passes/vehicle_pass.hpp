@@ -4,8 +4,9 @@
 
 namespace downpour::render {
 
-// Cars as simple shapes: the ego vehicle in outside views (its hood alone from the cockpit) and
-// the traffic the simulator reports.
+// Vehicles as simple shapes: the ego car in outside views (its hood alone from the cockpit) and
+// the traffic the simulator reports, each in its class's shape (car, truck, bus, motorbike)
+// scaled to its size.
 class VehiclePass final : public Pass {
  public:
   explicit VehiclePass(SharedResources& shared);
@@ -13,8 +14,9 @@ class VehiclePass final : public Pass {
   void execute(const FrameContext& frame, const FrameResources& resources) override;
 
  private:
-  void draw_car(const glm::mat4& model, const glm::vec3& colour, const sim::VehicleLights& lights,
-                bool flash_on, bool hull_only);
+  // Sets a vehicle's model matrix, colour and lamps for the meshes drawn next.
+  void prepare(const glm::mat4& model, const glm::vec3& colour, const sim::VehicleLights& lights,
+               bool flash_on);
 
   const PassDecl decl_{"vehicles",
                        {},
@@ -24,6 +26,7 @@ class VehiclePass final : public Pass {
   Uniform u_model_, u_body_colour_, u_lamps_, u_head_;
   Mesh hull_;
   Mesh upper_;
+  Mesh truck_, bus_, motorbike_;
 };
 
 }  // namespace downpour::render

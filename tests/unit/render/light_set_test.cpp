@@ -11,6 +11,7 @@
 #include <glm/trigonometric.hpp>
 
 #include "server/render/camera.hpp"
+#include "server/sim/vehicle_class.hpp"
 
 namespace downpour::render {
 namespace {
@@ -65,6 +66,41 @@ TEST(LightSetTest, AtNightEachCarShowsItsLampsWhereTheyAreAimedWhereTheyShine) {
   s.sim_time_s = 0.5;
   EXPECT_EQ(count(build_lights(s, {}, glm::vec3(0.0f)), LampKind::kIndicator, 0), 0)
       << "between flashes";
+}
+
+TEST(LightSetTest, EachClassCarriesItsLampsWhereItsShapeHasThem) {
+  // A truck and a bus have their headlamps low on a tall front, a motorbike one lamp each way;
+  // each scaled with its size.
+  sim::SceneState s = night_scene();
+  const auto vehicle = [](sim::VehicleClass c, double x, double scale) {
+    sim::TrafficVehicle v;
+    v.vehicle_class = c;
+    v.state.position_m = {x, 0.0, 0.0};
+    v.size_m = sim::vehicle_layout(c).size_m * scale;
+    return v;
+  };
+  s.traffic = {vehicle(sim::VehicleClass::kTruck, 30.0, 1.0),
+               vehicle(sim::VehicleClass::kBus, 60.0, 1.0),
+               vehicle(sim::VehicleClass::kMotorbike, 90.0, 1.1)};
+  sim::VehicleLights on;
+  on.headlights = sim::Headlights::kLow;
+  on.brake = true;
+  s.traffic_lights = {on, on, on};
+  const std::vector<Light> lights = build_lights(s, {}, glm::vec3(0.0f));
+  for (int v = 0; v < 3; ++v) {
+    EXPECT_EQ(count(lights, LampKind::kHeadlight, v), v == 2 ? 1 : 2) << v;
+    EXPECT_EQ(count(lights, LampKind::kBrake, v), v == 2 ? 1 : 2) << v;
+  }
+  for (const Light& l : lights) {
+    if (l.vehicle == 0 && l.kind == LampKind::kHeadlight) {
+      EXPECT_NEAR(l.position.x, 30.0f + 8.98f, 0.01f) << "the truck's front";
+      EXPECT_NEAR(l.position.z, 0.85f, 0.01f);
+    }
+    if (l.vehicle == 2 && l.kind == LampKind::kHeadlight) {
+      EXPECT_NEAR(l.position.x, 90.0f + 1.7f * 1.1f, 0.01f) << "the motorbike's, scaled";
+      EXPECT_NEAR(l.position.y, 0.0f, 1e-6f) << "on its centre line";
+    }
+  }
 }
 
 TEST(LightSetTest, ByDayNothingIsLitAndAtNightTheNearestStreetLights) {

@@ -199,6 +199,24 @@ TEST(ValidationTest, BadTrafficVehicleIsNamedByIndex) {
   EXPECT_TRUE(invalid_naming(update(u), "update.traffic[1].state.velocity_mps.x"));
 }
 
+TEST(ValidationTest, TrafficClassesSetTheirSizeUnlessOneIsGiven) {
+  v1::Update u;
+  u.add_traffic()->set_vehicle_class(v1::VEHICLE_CLASS_TRUCK);
+  v1::TrafficVehicle* bike = u.add_traffic();
+  bike->set_vehicle_class(v1::VEHICLE_CLASS_MOTORBIKE);
+  bike->mutable_size_m()->set_x(2.0);
+  bike->mutable_size_m()->set_y(0.7);
+  bike->mutable_size_m()->set_z(1.4);
+  sim::Update out;
+  ASSERT_TRUE(to_update(u, "update", Limits{}, &out).ok());
+  EXPECT_EQ((*out.traffic)[0].vehicle_class, sim::VehicleClass::kTruck);
+  EXPECT_EQ((*out.traffic)[0].size_m, glm::dvec3(12.0, 2.5, 3.8));
+  EXPECT_EQ((*out.traffic)[1].vehicle_class, sim::VehicleClass::kMotorbike);
+  EXPECT_EQ((*out.traffic)[1].size_m, glm::dvec3(2.0, 0.7, 1.4));
+  u.mutable_traffic(1)->set_vehicle_class(static_cast<v1::VehicleClass>(17));
+  EXPECT_TRUE(invalid_naming(update(u), "update.traffic[1].vehicle_class"));
+}
+
 TEST(ValidationTest, CameraPoseIsForTheRoadAndCockpitViewsOnly) {
   v1::CreateSessionRequest r;
   *r.add_views() = view(v1::VIEW_WINDSHIELD);
@@ -390,7 +408,7 @@ TEST(ValidationTest, GoodInputsConvertToDomainValues) {
   ASSERT_EQ(initial.traffic->size(), 1u);
   EXPECT_EQ((*initial.traffic)[0].id, 9u);
   EXPECT_EQ((*initial.traffic)[0].state.position_m.x, 130.0);
-  EXPECT_EQ((*initial.traffic)[0].size_m, glm::dvec3(4.5, 1.8, 1.5));  // zero size = a car
+  EXPECT_EQ((*initial.traffic)[0].size_m, glm::dvec3(4.6, 1.8, 1.47));  // zero size = a car's
 }
 
 TEST(ValidationTest, WiperIntervalDefaultsAndRange) {

@@ -1,0 +1,86 @@
+// The traffic's classes on pictures: a truck, a bus and a motorbike seen from the side stand as
+// long and as tall in the image as their sizes say, each in its own shape.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <glm/trigonometric.hpp>
+
+#include "server/render/camera.hpp"
+#include "server/sim/pose.hpp"
+#include "server/sim/vehicle_class.hpp"
+#include "tests/render/render_fixture.hpp"
+
+namespace downpour::render {
+namespace {
+
+using testing::RgbaImage;
+
+constexpr int kWidth = 320;
+constexpr int kHeight = 180;
+
+class VehicleClassesTest : public testing::RenderTest {};
+
+TEST_F(VehicleClassesTest, EachClassStandsAsLongAndTallAsItsSize) {
+  const sim::SceneState base = dry_scene();
+  const sim::Track& track = sim::Track::built_in();
+  const double s0 = track.project(glm::dvec2(base.vehicle.position_m), 50.0).s;
+  // The vehicle's middle 25 m ahead in the lane left of the ego car's; the camera 16 m to its
+  // right side, 2 m up, looking square at it (the ego car's frame: yaw 90 looks left).
+  const sim::ViewSpec spec =
+      posed_view(sim::View::kRoad, kWidth, kHeight, {25.0, -12.5, 2.0}, 90.0, 0.0, 40.0);
+  const RgbaImage empty = render(spec, base);
+  for (const sim::VehicleClass c : {sim::VehicleClass::kCar, sim::VehicleClass::kTruck,
+                                    sim::VehicleClass::kBus, sim::VehicleClass::kMotorbike}) {
+    const sim::VehicleLayout& layout = sim::vehicle_layout(c);
+    sim::SceneState s = base;
+    const sim::TrackFrame f = track.at(s0 + 25.0 - 0.5 * layout.size_m.x - layout.rear_m);
+    sim::TrafficVehicle v;
+    v.id = 0;  // silver
+    v.vehicle_class = c;
+    v.size_m = layout.size_m;
+    const glm::dvec2 xy = glm::dvec2(f.position) + f.left * track.lane_centre(0);
+    v.state.position_m = {xy.x, xy.y, track.surface_height(s0 + 25.0, track.lane_centre(0))};
+    v.state.rotation.yaw_deg = glm::degrees(f.heading_rad);
+    s.traffic = {v};
+    s.traffic_lights = {sim::VehicleLights{}};
+    const RgbaImage image = render(spec, s);
+    const std::string name = "vehicle_class_" + std::to_string(static_cast<int>(c)) + ".png";
+    if (const char* dir = std::getenv("DOWNPOUR_TEST_IMAGES"))
+      testing::write_png(std::string(dir) + "/" + name, image);
+    // The changed pixels' box against the projected box of the vehicle's size.
+    int x0 = kWidth, x1 = -1, y0 = kHeight, y1 = -1;
+    for (int y = 0; y < kHeight; ++y) {
+      for (int x = 0; x < kWidth; ++x) {
+        const std::size_t i = (static_cast<std::size_t>(y) * kWidth + x) * 4;
+        int d = 0;
+        for (int k = 0; k < 3; ++k)
+          d = std::max(d, std::abs(image.pixels[i + k] - empty.pixels[i + k]));
+        if (d > 6)
+          x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+      }
+    }
+    const Camera camera = make_camera(spec, s.vehicle);
+    const glm::dmat4 to_world = sim::vehicle_to_world(v.state);
+    const auto pixel = [&](double x, double z) {
+      const glm::vec4 w(to_world * glm::dvec4(x, -0.5 * v.size_m.y, z, 1.0));
+      const glm::vec4 clip = camera.projection * camera.view * w;
+      return glm::vec2((clip.x / clip.w * 0.5f + 0.5f) * kWidth,
+                       (0.5f - clip.y / clip.w * 0.5f) * kHeight);
+    };
+    const glm::vec2 rear_bottom = pixel(layout.rear_m, 0.0);
+    const glm::vec2 front_top = pixel(layout.rear_m + layout.size_m.x, layout.size_m.z);
+    const float expected_w = std::abs(front_top.x - rear_bottom.x);
+    const float expected_h = std::abs(rear_bottom.y - front_top.y);
+    std::printf("class %d: %d x %d px, its size %.0f x %.0f px\n", static_cast<int>(c), x1 - x0 + 1,
+                y1 - y0 + 1, expected_w, expected_h);
+    ASSERT_GE(x1, x0) << "the vehicle shows";
+    EXPECT_NEAR(x1 - x0 + 1, expected_w, 0.12 * expected_w + 3.0) << static_cast<int>(c);
+    EXPECT_NEAR(y1 - y0 + 1, expected_h, 0.12 * expected_h + 3.0) << static_cast<int>(c);
+  }
+}
+
+}  // namespace
+}  // namespace downpour::render
