@@ -25,7 +25,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     net = parse_opendrive(std::string_view(reinterpret_cast<const char*>(data), size), limits);
   } catch (const ParseError& e) {
-    require(e.line() >= 0);
+    require(!e.element().empty() && e.line() >= 0);
     return 0;
   }
   for (const Road& road : net.roads) {

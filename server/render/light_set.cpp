@@ -50,10 +50,22 @@ void add_vehicle(const glm::dmat4& to_world, const glm::vec3& scale, const glm::
   };
   const bool heads =
       lit.headlights == sim::Headlights::kLow || lit.headlights == sim::Headlights::kHigh;
+  // A vehicle with one lamp each way (y = 0: a motorbike) still has an indicator each side.
+  const bool single = head_m.y == 0.0f;
+  constexpr float kSingleIndicatorY = 0.14f;
   for (float side : {1.0f, -1.0f}) {
-    if (side < 0.0f && head_m.y == 0.0f) break;  // a single lamp each way
     const glm::vec3 head(head_m.x, head_m.y * side, head_m.z);
     const glm::vec3 tail(tail_m.x, tail_m.y * side, tail_m.z);
+    const bool indicator = side > 0 ? lit.left_indicator : lit.right_indicator;
+    if (indicator && flash_on) {
+      const glm::vec3 aside =
+          single ? glm::vec3(0.0f, kSingleIndicatorY * side, 0.0f) : glm::vec3(0.0f);
+      lamp(tail + aside, -forward, kAmber * c.indicator_cd, 20.0f, c.rear_lamp_outer_deg,
+           LampKind::kIndicator);
+      lamp(head + aside, forward, kAmber * c.indicator_cd, 20.0f, c.rear_lamp_outer_deg,
+           LampKind::kIndicator);
+    }
+    if (single && side < 0.0f) break;
     if (lit.headlights == sim::Headlights::kLow) {
       const float down = glm::radians(c.low_beam_down_deg);
       lamp(head, forward * std::cos(down) - up * std::sin(down), kHeadlightWhite * c.low_beam_cd,
@@ -67,13 +79,6 @@ void add_vehicle(const glm::dmat4& to_world, const glm::vec3& scale, const glm::
       lamp(tail, -forward, kRed * c.tail_cd, 20.0f, c.rear_lamp_outer_deg, LampKind::kTail);
     if (lit.brake) {
       lamp(tail, -forward, kRed * c.brake_cd, 20.0f, c.rear_lamp_outer_deg, LampKind::kBrake);
-    }
-    const bool indicator = side > 0 ? lit.left_indicator : lit.right_indicator;
-    if (indicator && flash_on) {
-      lamp(tail, -forward, kAmber * c.indicator_cd, 20.0f, c.rear_lamp_outer_deg,
-           LampKind::kIndicator);
-      lamp(head, forward, kAmber * c.indicator_cd, 20.0f, c.rear_lamp_outer_deg,
-           LampKind::kIndicator);
     }
     if (lit.reverse) {
       lamp(tail, -forward, kWhite * c.reverse_cd, 20.0f, c.rear_lamp_outer_deg, LampKind::kReverse);

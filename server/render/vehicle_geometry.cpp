@@ -130,9 +130,9 @@ MeshData build_motorbike() {
   add_wheels(m, {0.0f, 1.45f}, 0.0f, 0.32f, 0.14f);
   m.add_box({0.05f, -0.17f, 0.45f}, {1.25f, 0.17f, 0.9f}, material::kBody);
   m.add_box({1.2f, -0.08f, 0.4f}, {1.5f, 0.08f, 1.0f}, material::kTrim);
-  m.add_box({0.3f, -0.2f, 0.9f}, {0.7f, 0.2f, 1.35f}, material::kTrim);      // rider's body
+  m.add_box({0.3f, -0.2f, 0.9f}, {0.7f, 0.2f, 1.27f}, material::kTrim);      // the rider
   m.add_box({0.6f, -0.3f, 1.05f}, {1.2f, 0.3f, 1.15f}, material::kTrim);     // arms to the bars
-  m.add_box({0.38f, -0.14f, 1.35f}, {0.66f, 0.14f, 1.6f}, material::kBody);  // helmet
+  m.add_box({0.38f, -0.14f, 1.27f}, {0.66f, 0.14f, 1.5f}, material::kBody);  // helmet
   const auto hx = static_cast<float>(l.headlamp_m.x), hz = static_cast<float>(l.headlamp_m.z);
   const auto tx = static_cast<float>(l.tail_lamp_m.x), tz = static_cast<float>(l.tail_lamp_m.z);
   m.add_box({hx - 0.12f, -0.09f, hz - 0.08f}, {hx, 0.09f, hz + 0.08f}, material::kHeadlamp);

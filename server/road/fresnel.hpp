@@ -9,8 +9,9 @@ struct Fresnel {
   double s = 0.0;
 };
 
-// Both integrals at x (odd in x), to about 1e-10 (the power series in long double up to |x| = 4,
-// the asymptotic expansion, cut at its smallest term, beyond).
+// Both integrals at x (odd in x): the power series in long double up to |x| = 4 (its terms grow
+// to some 1e10 before they cancel: about 1e-10 with x86-64's 80-bit long double, worse where long
+// double is a double), the asymptotic expansion, cut at its smallest term, beyond.
 Fresnel fresnel(double x);
 
 // A point of the clothoid that starts at the origin heading along +x with curvature 0 and whose

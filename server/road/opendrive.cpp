@@ -50,10 +50,21 @@ struct LocalCurve {
 // metre. Through the Fresnel integrals (the standard clothoid whose curvature passes k0 at
 // s0 = k0 / rate); where that clothoid is so wide that its coordinates would swamp the piece
 // (a rate under some 3e-10 / m^2), by quadrature of the heading instead.
+// The heading-relative point of an arc of curvature k at ds (a line for k = 0).
+RefPoint arc_local(double k, double ds) {
+  if (std::abs(k) < 1e-12) return {ds, 0.0, 0.0};
+  const double a = k * ds;
+  return {std::sin(a) / k, (1.0 - std::cos(a)) / k, a};
+}
+
 RefPoint spiral_local(double k0, double rate, double ds) {
-  if (rate == 0.0 || std::sqrt(std::numbers::pi / std::abs(rate)) > 1e5) {
+  if (rate == 0.0 || !std::isfinite(rate)) return arc_local(k0, ds);
+  if (std::sqrt(std::numbers::pi / std::abs(rate)) > 1e5) {
     const auto heading = [&](double u) { return u * (k0 + 0.5 * rate * u); };
-    const int pieces = std::max(1, static_cast<int>(std::ceil(ds / 5.0)));
+    // A piece per 0.1 rad of turn and per 50 m, at most 512 (a file's coil of a road gets a
+    // rougher answer, not a longer wait).
+    const double turn = std::abs(k0) * ds + 0.5 * std::abs(rate) * ds * ds;
+    const int pieces = static_cast<int>(std::clamp(std::ceil(turn / 0.1 + ds / 50.0), 1.0, 512.0));
     double x = 0.0, y = 0.0;
     for (int i = 0; i < pieces; ++i) {
       const double a = ds * i / pieces, b = ds * (i + 1) / pieces;
@@ -121,15 +132,11 @@ RefPoint Geometry::at(double ds) const {
       local = {ds, 0.0, 0.0};
       break;
     case Kind::kArc:
-      if (std::abs(curvature) < 1e-12) {
-        local = {ds, 0.0, 0.0};
-      } else {
-        const double a = curvature * ds;
-        local = {std::sin(a) / curvature, (1.0 - std::cos(a)) / curvature, a};
-      }
+      local = arc_local(curvature, ds);
       break;
     case Kind::kSpiral:
-      local = spiral_local(curv_start, length > 0.0 ? (curv_end - curv_start) / length : 0.0, ds);
+      // (A record too short to turn in is its start's arc.)
+      local = spiral_local(curv_start, length > 1e-6 ? (curv_end - curv_start) / length : 0.0, ds);
       break;
     case Kind::kPoly3:
     case Kind::kParamPoly3: {
@@ -316,6 +323,14 @@ class Parser {
     }
     return v;
   }
+  double curvature(const pugi::xml_node& node, const char* name) {
+    const double v = number(node, name);
+    if (std::abs(v) > limits_.max_curvature) {
+      fail(node, std::string("attribute ") + name + " is sharper than " +
+                     std::to_string(limits_.max_curvature) + " per metre");
+    }
+    return v;
+  }
   double non_negative(const pugi::xml_node& node, const char* name,
                       double fallback = std::nan("")) {
     const double v = number(node, name, fallback);
@@ -371,9 +386,9 @@ class Parser {
     g.y = coordinate(node, "y");
     g.heading = number(node, "hdg");
     g.length = non_negative(node, "length");
-    if (g.s > road.length + 1e-3 || g.length > limits_.max_road_length_m) {
-      fail(node, "lies beyond its road's length");
-    }
+    // (Files round their lengths: a metre or a thousandth of the road's over is let pass.)
+    const double slack = std::max(1.0, 1e-3 * road.length);
+    if (g.s + g.length > road.length + slack) fail(node, "runs beyond its road's length");
     int kinds = 0;
     for (const pugi::xml_node shape : node.children()) {
       const std::string_view name = shape.name();
@@ -381,11 +396,11 @@ class Parser {
         g.kind = Geometry::Kind::kLine;
       } else if (name == "arc") {
         g.kind = Geometry::Kind::kArc;
-        g.curvature = number(shape, "curvature");
+        g.curvature = curvature(shape, "curvature");
       } else if (name == "spiral") {
         g.kind = Geometry::Kind::kSpiral;
-        g.curv_start = number(shape, "curvStart");
-        g.curv_end = number(shape, "curvEnd");
+        g.curv_start = curvature(shape, "curvStart");
+        g.curv_end = curvature(shape, "curvEnd");
       } else if (name == "poly3") {
         g.kind = Geometry::Kind::kPoly3;
         g.au = 0.0, g.bu = 1.0, g.cu = 0.0, g.du = 0.0;
@@ -416,34 +431,35 @@ class Parser {
     road.plan_view.push_back(std::move(g));
   }
 
-  // The arc length table of a poly3 / paramPoly3 record (and a poly3's parameter end, where its
-  // arc length reaches the record's length: u grows at least as fast as the arc length does not,
-  // so the end lies in [0, length]).
+  // The arc length table of a poly3 / paramPoly3 record, a knot every half metre of its length
+  // (16 to 4096). A poly3's parameter u ends where its arc length reaches the record's length:
+  // the arc grows at least as fast as u, so by u = length at the latest; a first table over
+  // [0, length] finds that end, a second one covers [0, end].
   void build_knots(const pugi::xml_node& node, Geometry& g) {
     const LocalCurve curve{g};
-    if (g.kind == Geometry::Kind::kPoly3) {
-      double lo = 0.0, hi = g.length;
-      for (int i = 0; i < 60 && hi - lo > 1e-10; ++i) {
-        const double mid = 0.5 * (lo + hi);
-        double arc = 0.0;
-        const int pieces = 16;
-        for (int k = 0; k < pieces; ++k) arc += curve.arc(mid * k / pieces, mid * (k + 1) / pieces);
-        (arc < g.length ? lo : hi) = mid;
-      }
-      g.p_end = 0.5 * (lo + hi);
-    } else {
-      g.p_end = g.p_normalized ? 1.0 : g.length;
-    }
     const auto n = static_cast<std::size_t>(std::clamp(g.length / 0.5, 16.0, 4096.0));
-    g.knot_s.assign(n + 1, 0.0);
-    for (std::size_t k = 0; k < n; ++k) {
-      const double p0 = g.p_end * static_cast<double>(k) / static_cast<double>(n);
-      const double p1 = g.p_end * static_cast<double>(k + 1) / static_cast<double>(n);
-      g.knot_s[k + 1] = g.knot_s[k] + curve.arc(p0, p1);
+    const auto table = [&](double p_end) {
+      knots_ += n + 1;
+      if (knots_ > limits_.max_curve_knots) {
+        fail(node, "the file's curves need more than " + std::to_string(limits_.max_curve_knots) +
+                       " samples in all");
+      }
+      g.p_end = p_end;
+      g.knot_s.assign(n + 1, 0.0);
+      for (std::size_t k = 0; k < n; ++k) {
+        const double p0 = p_end * static_cast<double>(k) / static_cast<double>(n);
+        const double p1 = p_end * static_cast<double>(k + 1) / static_cast<double>(n);
+        g.knot_s[k + 1] = g.knot_s[k] + curve.arc(p0, p1);
+      }
+      if (!std::isfinite(g.knot_s.back())) fail(node, "its curve's length is not finite");
+    };
+    if (g.kind == Geometry::Kind::kPoly3) {
+      table(g.length);
+      table(param_at(g, g.length));
+    } else {
+      table(g.p_normalized ? 1.0 : g.length);
     }
-    if (!std::isfinite(g.knot_s.back()) || g.knot_s.back() <= 0.0) {
-      if (g.length > 0.0) fail(node, "its curve has no length");
-    }
+    if (g.length > 0.0 && g.knot_s.back() <= 0.0) fail(node, "its curve has no length");
   }
 
   Lane parse_lane(const pugi::xml_node& node) {
@@ -581,6 +597,7 @@ class Parser {
   std::string_view text_;
   Limits limits_;
   std::size_t records_ = 0;
+  std::size_t knots_ = 0;
 };
 
 }  // namespace

@@ -159,6 +159,10 @@ struct Limits {
   double max_coordinate_m = 1e7;  // |x|, |y|
   // Any number at all (so that a cubic over a road's length stays finite).
   double max_number = 1e9;
+  double max_curvature = 1.0;  // 1/m: a 1 m radius, far sharper than any road's
+  // Poly3 and paramPoly3 records' arc-length samples (a knot every half metre, 16 to 4096 a
+  // record), in all.
+  std::size_t max_curve_knots = 4'000'000;
 };
 
 // A file refused: the element and the line of the text it is on (1-based; 0 when the text is not

@@ -207,14 +207,16 @@ void Simulation::spray_step() {
       std::clamp(state_.sim_time_s - step_end_s_, -kMaxExtrapolationS, kMaxExtrapolationS);
   std::vector<SpraySource> sources;
   sources.reserve(state_.traffic.size() + 1);
-  auto add = [&](std::uint32_t key, const VehicleState& state, glm::dvec3 size) {
-    SpraySource s{key, state, size};
+  auto add = [&](std::uint32_t key, const VehicleState& state, glm::dvec3 size,
+                 VehicleClass vehicle_class) {
+    SpraySource s{key, state, size, vehicle_class};
     s.state.position_m += state.velocity_mps * ahead;
     sources.push_back(s);
   };
-  add(0, state_.vehicle, glm::dvec3(4.5, 1.8, 1.47));
+  add(0, state_.vehicle, glm::dvec3(4.5, 1.8, 1.47), VehicleClass::kCar);
   for (const TrafficVehicle& other : state_.traffic)
-    add(other.id == UINT32_MAX ? other.id : other.id + 1, other.state, other.size_m);
+    add(other.id == UINT32_MAX ? other.id : other.id + 1, other.state, other.size_m,
+        other.vehicle_class);
   RoadWaterGround ground(road_);
   if (state_.road_water) {
     ground.set_mean(state_.road_water->mean_water_mm * 1e-3,

@@ -9,6 +9,7 @@
 #include "server/sim/car_body.hpp"
 #include "server/sim/pose.hpp"
 #include "server/sim/road_water.hpp"
+#include "server/sim/vehicle_class.hpp"
 
 namespace downpour::sim {
 namespace {
@@ -233,7 +234,12 @@ void Spray::step(const std::vector<SpraySource>& sources, glm::dvec3 wind, Spray
     const glm::dvec3 size = glm::max(s.size_m, glm::dvec3(0.5));
     p.scale = size / glm::dvec3(kCarLength, kCarWidth, kCarHeight);
     p.height = size.z;
-    p.rear_x = car_body::kHullRearX * p.scale.x;
+    // Where the flow leaves the body: a car's hull top edge (its bumper sits further back, low),
+    // the other classes' square backs.
+    const VehicleLayout& layout = vehicle_layout(s.vehicle_class);
+    const double rear =
+        s.vehicle_class == VehicleClass::kCar ? car_body::kHullRearX : layout.rear_m;
+    p.rear_x = rear * size.x / layout.size_m.x;
     poses.push_back(p);
   }
   std::vector<std::pair<std::uint32_t, std::size_t>> by_key;

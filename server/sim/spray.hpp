@@ -117,6 +117,7 @@ struct SpraySource {
   std::uint32_t key = 0;
   VehicleState state;
   glm::dvec3 size_m{4.5, 1.8, 1.47};
+  VehicleClass vehicle_class = VehicleClass::kCar;  // where its back is (its wake starts there)
 };
 
 struct SprayParticle {

@@ -77,8 +77,8 @@ TEST_F(VehicleClassesTest, EachClassStandsAsLongAndTallAsItsSize) {
     std::printf("class %d: %d x %d px, its size %.0f x %.0f px\n", static_cast<int>(c), x1 - x0 + 1,
                 y1 - y0 + 1, expected_w, expected_h);
     ASSERT_GE(x1, x0) << "the vehicle shows";
-    EXPECT_NEAR(x1 - x0 + 1, expected_w, 0.12 * expected_w + 3.0) << static_cast<int>(c);
-    EXPECT_NEAR(y1 - y0 + 1, expected_h, 0.12 * expected_h + 3.0) << static_cast<int>(c);
+    EXPECT_NEAR(x1 - x0 + 1, expected_w, 0.05 * expected_w + 2.0) << static_cast<int>(c);
+    EXPECT_NEAR(y1 - y0 + 1, expected_h, 0.05 * expected_h + 2.0) << static_cast<int>(c);
   }
 }
 

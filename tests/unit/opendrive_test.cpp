@@ -200,6 +200,15 @@ TEST(OpenDrive, ParsedCubicCurvesReachTheirLength) {
   }
   EXPECT_NEAR(arc_to(road.reference(30.0).x), 30.0, 1e-6);
   EXPECT_NEAR(arc_to(road.reference(110.0).x), 30.0, 1e-4);
+  // The curves' samples count against a limit.
+  Limits few;
+  few.max_curve_knots = 300;
+  try {
+    parse_opendrive(file, few);
+    ADD_FAILURE() << "parsed";
+  } catch (const ParseError& e) {
+    EXPECT_NE(std::string(e.what()).find("samples"), std::string::npos) << e.what();
+  }
 }
 
 // A two-road file with a junction: a straight, then a spiral and arc into a bend, lanes with
@@ -374,6 +383,9 @@ TEST(OpenDrive, LimitsBoundWhatAFileMayCost) {
       refused(with(kTwoRoads, R"(length="100.0" id="1")", R"(length="1e9" id="1")")).element(),
       "road");
   EXPECT_EQ(refused(with(kTwoRoads, R"(x="139.365")", R"(x="1e12")")).element(), "geometry");
+  EXPECT_EQ(
+      refused(with(kTwoRoads, R"(<arc curvature="0.02"/>)", R"(<arc curvature="2"/>)")).element(),
+      "arc");
 }
 
 }  // namespace

@@ -1,2 +1,3 @@
-"""CARLA to Downpour: the mapping of frames, poses, weather and lamps (mapping), and a bridge
-that drives a Downpour session from a running CARLA server (bridge)."""
+"""CARLA to Downpour: the mapping of frames, poses, weather and lamps into the contract's terms
+(mapping). The bridge that drives a session from a CARLA server follows once sessions take road
+networks."""

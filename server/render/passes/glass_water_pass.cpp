@@ -26,7 +26,7 @@ GlassWaterPass::GlassWaterPass(SharedResources&, GlassWaterConfig config)
   program_.uniform("u_glint").set(config_.sun_glint);
   program_.uniform("u_lamp_spread")
       .set(glm::vec2(std::cos(config_.lamp_spread_rad[0]), std::cos(config_.lamp_spread_rad[1])));
-  lamps_.reserve(2 * kGlassLamps);
+  lamps_.reserve(2 * kGlassLamps + 2);  // an insertion before the list is cut back
 }
 
 bool GlassWaterPass::wanted(const FrameContext& frame) const {

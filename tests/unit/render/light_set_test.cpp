@@ -85,8 +85,12 @@ TEST(LightSetTest, EachClassCarriesItsLampsWhereItsShapeHasThem) {
   sim::VehicleLights on;
   on.headlights = sim::Headlights::kLow;
   on.brake = true;
-  s.traffic_lights = {on, on, on};
+  sim::VehicleLights hazard = on;
+  hazard.left_indicator = hazard.right_indicator = true;
+  s.traffic_lights = {on, on, hazard};
+  s.sim_time_s = 0.1;  // the indicators' flash lit
   const std::vector<Light> lights = build_lights(s, {}, glm::vec3(0.0f));
+  EXPECT_EQ(count(lights, LampKind::kIndicator, 2), 4) << "the motorbike's hazards: each side";
   for (int v = 0; v < 3; ++v) {
     EXPECT_EQ(count(lights, LampKind::kHeadlight, v), v == 2 ? 1 : 2) << v;
     EXPECT_EQ(count(lights, LampKind::kBrake, v), v == 2 ? 1 : 2) << v;
