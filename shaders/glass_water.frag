@@ -25,7 +25,7 @@ uniform float u_rim_darkening;
 uniform vec2 u_rim_lean;  // the lean where rims start to darken and where they are darkest
 uniform float u_glint;    // the sun seen through a drop, relative to its direct light
 uniform int u_lamp_count;
-uniform vec4 u_lamps[16];  // per lamp: the unit direction towards it and the radiance its drops
+uniform vec4 u_lamps[8];  // per lamp: the unit direction towards it and the radiance its drops
                            // show (display units); its colour
 uniform vec2 u_lamp_spread;  // cosines: full out to x from the lamp, none past y
 

@@ -31,8 +31,10 @@ struct GlassWaterConfig {
   float lamp_spread_rad[2] = {0.10f, 0.44f};
 };
 
-// At most this many lamps light the drops: the strongest glares, above a least one.
-inline constexpr int kGlassLamps = 8;
+// At most this many lamps light the drops: the strongest glares, above a least one (eight cost the
+// glass water pass 0.25 ms in the lights benchmark's rain, four 0.1, and the brightest few make
+// the bloom).
+inline constexpr int kGlassLamps = 4;
 
 // COCKPIT: the water on the glass as the view sees it, into the glass layer at 1 / layer_scale of
 // the view's size (GlassView: its pixels as wide as the lens's blur of the glass). Each drop is a
