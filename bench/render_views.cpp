@@ -21,6 +21,10 @@
 // --sun ALT AZ: the sun's altitude and azimuth (degrees) in place of the scene's; --cloud C its
 //   cloudiness [0, 1]; --fog F its fog density [0, 1]; --no-relief: without the relief's shadows
 //   (seed 002).
+// --xodr FILE ROAD S LANE: on the roads of an OpenDRIVE file, the car on road ROAD (its id) at S
+//   metres along it, in lane LANE (an OpenDRIVE lane id: negative to the right of the reference
+//   line, driving along it; positive against it), without the scene's traffic; --lift M PITCH: the
+//   car M metres over its place, pitched PITCH degrees nose down (to look at the roads from above).
 // --wipe: a wipe as a picture sequence: the scene's weather and drive at t_s with the wipers off
 //   for t_s seconds, then one SINGLE wipe; COCKPIT, WINDSHIELD (and --dash) written before it,
 //   every sixth of the cycle through it, and after (wipe_K_*.png).
@@ -29,17 +33,21 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <fstream>
 #include <map>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include <glm/gtc/constants.hpp>
 #include <glm/trigonometric.hpp>
 
 #include "bench/view_costs.hpp"
 #include "server/render/camera.hpp"
 #include "server/render/renderer.hpp"
 #include "server/render/view_wet_fraction.hpp"
+#include "server/sim/opendrive_roads.hpp"
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"
 #include "tests/render/road_water_fixture.hpp"
@@ -118,8 +126,30 @@ int main(int argc, char** argv) {
   std::optional<std::array<double, 2>> sun;
   double cloud = -1.0, fog = -1.0;
   bool relief = true;
+  std::shared_ptr<const sim::OpenDriveRoads> roads;
+  std::string xodr_road;
+  double xodr_s = 0.0;
+  int xodr_lane = -1;
+  double lift_m = 0.0, lift_pitch_deg = 0.0;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
+    if (arg == "--xodr" && i + 4 < argc) {
+      std::ifstream file(argv[i + 1], std::ios::binary);
+      std::stringstream text;
+      text << file.rdbuf();
+      roads = std::make_shared<const sim::OpenDriveRoads>(road::parse_opendrive(text.str()));
+      xodr_road = argv[i + 2];
+      xodr_s = std::atof(argv[i + 3]);
+      xodr_lane = std::atoi(argv[i + 4]);
+      i += 4;
+      continue;
+    }
+    if (arg == "--lift" && i + 2 < argc) {
+      lift_m = std::atof(argv[i + 1]);
+      lift_pitch_deg = std::atof(argv[i + 2]);
+      i += 2;
+      continue;
+    }
     if (arg == "--windshield" && i + 1 < argc) {
       windshield_metaballs = std::atoi(argv[++i]);
     } else if (arg == "--blades" && i + 2 < argc) {
@@ -189,6 +219,27 @@ int main(int argc, char** argv) {
     update.vehicle->velocity_mps = glm::dvec3(std::cos(yaw), std::sin(yaw), 0.0) * speed;
   }
 
+  sim::SimulationConfig config;
+  if (roads) {
+    const road::Road* road = roads->network().find_road(xodr_road);
+    if (!road) {
+      std::fprintf(stderr, "no road %s in the file\n", xodr_road.c_str());
+      return 2;
+    }
+    const int index = static_cast<int>(road - roads->network().roads.data());
+    const double inner = road->lane_border(xodr_s, xodr_lane > 0 ? xodr_lane - 1 : xodr_lane + 1);
+    const double lane_t = 0.5 * (inner + road->lane_border(xodr_s, xodr_lane));
+    const sim::TrackFrame f = roads->frame(index, xodr_s);
+    const double heading = f.heading_rad + (xodr_lane > 0 ? glm::pi<double>() : 0.0);
+    const glm::dvec2 xy = glm::dvec2(f.position) + f.left * lane_t;
+    update.vehicle->position_m = glm::dvec3(xy, roads->surface_height({index, xodr_s, lane_t}));
+    update.vehicle->position_m.z += lift_m;
+    update.vehicle->rotation = {glm::degrees(heading), lift_pitch_deg, 0.0};
+    const double v = glm::length(update.vehicle->velocity_mps);
+    update.vehicle->velocity_mps = glm::dvec3(std::cos(heading), std::sin(heading), 0.0) * v;
+    update.traffic = std::vector<sim::TrafficVehicle>{};
+    config.roads = roads;
+  }
   if (wipe) return wipe_sequence(out, scenario.seed, update, t, width, height, dash);
   if (spray_drive) {
     if (speed >= 0.0) spray_drive->speed_mps = speed;
@@ -196,7 +247,7 @@ int main(int argc, char** argv) {
     spray_drive->seed = scenario.seed;
   }
   sim::Simulation simulation =
-      spray_drive ? testing::drive(*spray_drive) : sim::Simulation(scenario.seed, update);
+      spray_drive ? testing::drive(*spray_drive) : sim::Simulation(scenario.seed, update, config);
   if (spray_drive) {
     std::printf("spray: %zu parcels, %.2f ml on the glass\n", simulation.spray().particles().size(),
                 simulation.spray().ledger().on_glass_m3 * 1e6);

@@ -32,7 +32,7 @@ void picture(const sim::RoadWater& water, const sim::RoadSurface& surface,
   const glm::dvec2 corner = glm::dvec2(water.origin(levels - 1)) * water.cell_m(levels - 1);
   testing::RgbaImage image{side, side, {}};
   image.pixels.assign(static_cast<std::size_t>(side) * side * 4, 255);
-  const sim::Track& track = surface.track();
+  const sim::Track& track = sim::Track::built_in();  // the surface's (main() below)
   double s_guess = track.project(corner + 0.5 * side * cell, 40.0).s;
   for (int j = 0; j < side; ++j) {
     for (int i = 0; i < side; ++i) {
@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
   app.add_option("--s", s0, "where the car stands along the track (m)");
   CLI11_PARSE(app, argc, argv);
 
-  const sim::Track track = sim::Track::test_track();
+  const sim::Track& track = sim::Track::built_in();
   const sim::RoadSurface surface(track, seed);
   sim::RoadWater water(surface);
   auto at = [&](double s) {

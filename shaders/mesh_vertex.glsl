@@ -18,6 +18,10 @@ out vec4 v_principal_dirs;
 // part, -1 the far (the same distance negated, so that the parts meet without a crack).
 uniform vec2 u_near_split;
 #endif
+#ifdef ROAD_LANES
+layout(location = 5) in vec4 a_lane;  // mesh_data.hpp's VertexLane
+flat out vec4 v_strip;
+#endif
 void main() {
   vec4 world = u_model * vec4(a_position, 1.0);
   v_world = world.xyz;
@@ -27,6 +31,9 @@ void main() {
 #ifdef MESH_CURVATURE
   v_curvature = a_curvature;
   v_principal_dirs = a_principal_dirs;
+#endif
+#ifdef ROAD_LANES
+  v_strip = a_lane;
 #endif
   gl_Position = frame.view_proj * world;
   // The road reflection keeps what is above the road; other frames' plane keeps everything (a

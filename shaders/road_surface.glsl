@@ -10,9 +10,10 @@ in vec2 v_uv;  // x lateral offset (m, left positive), y distance along the trac
 in vec4 v_fog;
 out vec4 out_colour;
 
-uniform float u_lane_width;
-uniform int u_lanes_each_way;
-uniform float u_paved_half_width;
+// Its strip among the road's lanes (mesh_data.hpp's VertexLane): its right border's t, its width
+// (+ 100 on a lane cars drive in; +-1000 on a verge, whose t is the paved edge's), and the marks
+// on its borders, packed. (Flat: one varying, where llvmpipe pays for every one on every pixel.)
+flat in vec4 v_strip;
 
 const float kReliefTile = 1.5;  // metres of road per repeat of the relief texture (relief.hpp)
 const float kSettsTile = 1.0;   // the setts' (relief.hpp)
@@ -67,6 +68,26 @@ float relief_lit(vec3 l, vec2 tex, float layer0, float h) {
 float stripe(float x, float c, float hw) {
   float w = max(fwidth(x), 1e-4);
   return clamp((hw - abs(x - c)) / w + 0.5, 0.0, 1.0);
+}
+
+// A lane border's mark (mesh_data.hpp's pack_lane_mark) at u across from the border (m), w a
+// pixel's width in u, dash 1 where a broken line is painted. Of a double line, only the line on
+// u's side counts (they are apart). (x paint, y its yellow part.)
+vec2 lane_mark(float mark, float u, float w, float dash) {
+  int code = int(mark);
+  float kind = float(code & 7);
+  vec4 m = vec4(float(code & 8), float((code >> 4) & 63) * 0.01,
+                float(((code >> 10) & 127) - 64) * 0.01, float((code >> 17) & 127) * 0.01);
+  float c = m.b;
+  // Single lines: 1 solid, 2 broken; double lines, right then left: 3 solid solid, 4 solid broken,
+  // 5 broken solid, 6 broken broken.
+  float double_line = step(2.5, kind);
+  float right = step(u, c);
+  c += double_line * (0.5 - right) * m.a;
+  float solid = kind == 1.0 || kind == 3.0 || (right > 0.5 ? kind == 4.0 : kind == 5.0) ? 1.0 : 0.0;
+  float p = step(0.5, kind) * mix(dash, 1.0, solid) *
+            clamp((0.5 * m.g - abs(u - c)) / w + 0.5, 0.0, 1.0);
+  return vec2(p, p * step(8.0, m.r));  // (m.r: 8 if yellow)
 }
 
 // The water at xy: x all of it (mm), y the part standing above the texture (mm). From the finest
@@ -204,8 +225,13 @@ vec3 mirrored(vec3 p, vec3 r, vec3 sky, float streak) {
 void main() {
   float lat = v_uv.x;
   float s = v_uv.y;
-  float a = abs(lat);
-  float lanes = u_lane_width * float(u_lanes_each_way);
+  // How far beyond the paved edge (0 on the pavement), and where across its lane.
+  float on_verge = step(999.0, abs(v_strip.y));
+  float driving = step(99.5, v_strip.y) * (1.0 - on_verge);
+  float strip_w = mix(max(v_strip.y - 100.0 * driving, 0.01), sign(v_strip.y), on_verge);
+  // Across its strip from the right (0 .. 1); on a verge, the metres beyond the paved edge.
+  float lane_pos = (lat - v_strip.x) / strip_w;
+  float verge_d = max(lane_pos, 0.0) * on_verge;
 
   // Surface frame: normal from the mesh, tangent along the track from the uv derivatives.
   vec3 n_geo = normalize(v_normal);
@@ -216,8 +242,8 @@ void main() {
   vec3 t_lat = cross(n_geo, t_along);
 
   // The pavement's asphalt, then a band of stone setts on the shoulder, then gravel and grass.
-  float verge = smoothstep(u_paved_half_width, u_paved_half_width + 0.05, a);
-  float setts_band = verge * step(a, u_paved_half_width + kSettsWidth);
+  float verge = smoothstep(0.0, 0.05, verge_d);
+  float setts_band = verge * step(verge_d, kSettsWidth);
   vec4 relief = texture(asphalt_tex, vec2(lat, s) / kReliefTile);
   vec4 setts = texture(setts_tex, vec2(lat, s) / kSettsTile);
   // Fade the relief with distance, where its texels get smaller than a pixel (the setts', four
@@ -231,18 +257,20 @@ void main() {
   float h = relief.a;
   float patches = texture(noise_tex, vec2(lat, s) / 40.0).g;
   vec3 albedo = vec3(mix(0.055, 0.16, smoothstep(0.15, 0.8, h))) * (0.85 + 0.3 * patches);
-  float lane_pos = fract(a / u_lane_width);
   float wheel_paths = stripe(lane_pos, 0.27, 0.09) + stripe(lane_pos, 0.73, 0.09);
-  albedo *= 1.0 - 0.18 * clamp(wheel_paths, 0.0, 1.0) * step(a, lanes);
+  albedo *= 1.0 - 0.18 * clamp(wheel_paths, 0.0, 1.0) * driving;
 
-  // Markings: double centre line, dashed lane dividers (3 m on, 9 m off), solid edge lines.
-  float paint = stripe(a, 0.2, 0.07);
-  for (int i = 1; i < u_lanes_each_way; ++i) {
-    paint += stripe(a, u_lane_width * float(i), 0.075) * step(fract(s / 12.0), 0.25);
-  }
-  paint += stripe(a, lanes + 0.2, 0.1);
-  paint = clamp(paint, 0.0, 1.0);
-  albedo = mix(albedo, vec3(0.72, 0.72, 0.68), paint);
+  // Markings: the lines on the two borders of this pixel's lane, as its profile has them (broken
+  // lines 3 m on, 9 m off).
+  // (No branch: the stripes' derivatives need every pixel to take the same path.)
+  float pixel_w = max(fwidth(lat), 1e-4);
+  float dash = step(fract(s / 12.0), 0.25);
+  vec2 paint_yellow = lane_mark(v_strip.z, lane_pos * strip_w, pixel_w, dash) +
+                      lane_mark(v_strip.w, (lane_pos - 1.0) * strip_w, pixel_w, dash);
+  float paint = clamp(paint_yellow.x, 0.0, 1.0);
+  vec3 paint_colour = mix(vec3(0.72, 0.72, 0.68), vec3(0.62, 0.47, 0.1),
+                          clamp(paint_yellow.y / max(paint_yellow.x, 1e-3), 0.0, 1.0));
+  albedo = mix(albedo, paint_colour, paint);
   n = normalize(mix(n, n_geo, paint * 0.8));  // paint fills the relief
 
   // Beyond the pavement: grey setts in sand (each stone its own shade), gravel, then grass.
@@ -252,7 +280,7 @@ void main() {
   vec3 sett = vec3(0.2, 0.19, 0.18) * (0.75 + 0.5 * stone) * mix(0.55, 1.0, smoothstep(0.2, 0.5, setts.a));
   vec3 gravel = vec3(0.16, 0.15, 0.13) * (0.7 + 0.6 * h);
   vec3 grass = vec3(0.11, 0.16, 0.06) * (0.8 + 0.4 * patches);
-  vec3 beyond = mix(gravel, grass, smoothstep(u_paved_half_width + 1.6, u_paved_half_width + 2.8, a));
+  vec3 beyond = mix(gravel, grass, smoothstep(1.6, 2.8, verge_d));
   albedo = mix(albedo, mix(beyond, sett, setts_band), verge);
 
   // The water here (seed 003): the pores of the texture fill (wet: darker, the diffuse reduction

@@ -105,7 +105,9 @@ int main(int argc, char** argv) {
   limits.max_width = config->max_width;
   limits.max_height = config->max_height;
   limits.max_fps = config->max_fps;
-  rpc::DownpourService service(registry, scheduler, limits, auth);
+  auto road_networks = std::make_shared<rpc::RoadNetworks>(config->maps_dir);
+  if (!config->maps_dir.empty()) spdlog::info("maps from {}", config->maps_dir);
+  rpc::DownpourService service(registry, scheduler, limits, auth, road_networks);
 
   grpc::EnableDefaultHealthCheckService(true);
   // Probes that cannot speak TLS get the health service alone, in plaintext, on its own port.
@@ -131,7 +133,7 @@ int main(int argc, char** argv) {
   int port = 0;
   builder.AddListeningPort(config->listen, credentials, &port);
   builder.RegisterService(&service);
-  builder.SetMaxReceiveMessageSize(1 << 20);
+  builder.SetMaxReceiveMessageSize(config->max_message_mb << 20);
   builder.experimental().SetInterceptorCreators(rpc::malformed_request_interceptors());
   // Pings find a client whose host died with a stream open (no FIN ever comes): after 20 s of
   // silence a ping, and 10 s without its answer closes the connection, so the stream's lease on

@@ -171,6 +171,15 @@ std::optional<ServerConfig> parse_config(int argc, char** argv, int* exit_code) 
   app.add_option("--health-listen", c.health_listen,
                  "also serve grpc.health.v1 alone, in plaintext, here (for probes without TLS)")
       ->envname("DOWNPOUR_HEALTH_LISTEN");
+  app.add_option("--maps-dir", c.maps_dir,
+                 "OpenDRIVE maps (.xodr) that CreateSession may name (roads.map_name)")
+      ->check(CLI::ExistingDirectory)
+      ->envname("DOWNPOUR_MAPS_DIR");
+  app.add_option("--max-message-mb", c.max_message_mb,
+                 "largest request in MiB (raise it for inline OpenDRIVE roads; files are refused "
+                 "beyond 64)")
+      ->check(CLI::Range(1, 64))
+      ->envname("DOWNPOUR_MAX_MESSAGE_MB");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -49,6 +49,10 @@ struct ServerConfig {
   // A plaintext listener with the health service alone, for probes that cannot speak TLS
   // (Kubernetes' gRPC probes); empty = none.
   std::string health_listen;
+  // Road networks (the contract's RoadNetwork): OpenDRIVE files a session may name, in this
+  // directory (empty: none); and the largest request (inline OpenDRIVE text counts), MiB.
+  std::string maps_dir;
+  int max_message_mb = 1;
 };
 
 // Parses argv; on --help or an error returns the exit code to use instead of a config.

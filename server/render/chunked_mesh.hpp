@@ -16,6 +16,7 @@ class ChunkedMesh {
  public:
   // chunks[c][level]: level 0 the finest. A chunk is drawn at level k when its nearest point is
   // at least level_distances_m[k - 1] from the camera, and not at all from max_distance_m on.
+  ChunkedMesh() = default;
   ChunkedMesh(const std::vector<std::vector<MeshData>>& chunks,
               std::vector<float> level_distances_m, float max_distance_m = 1e30f);
   // Draws the chunks whose bounds meet the view's frustum with the bound program, each at the
@@ -37,7 +38,7 @@ class ChunkedMesh {
   };
   std::vector<Chunk> chunks_;
   std::vector<float> level_distances_m_;
-  float max_distance_m_;
+  float max_distance_m_ = 1e30f;
 };
 
 }  // namespace downpour::render

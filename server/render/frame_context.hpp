@@ -13,13 +13,13 @@
 #include "server/render/gl_objects.hpp"
 #include "server/render/glass_view.hpp"
 #include "server/sim/simulation.hpp"
-#include "server/sim/track.hpp"
 
 namespace downpour::render {
 namespace relief {
 struct RoadReliefs;
 }
 struct Light;
+struct World;
 
 struct FrameContext {
   // The simulator's inputs for this frame: pose, weather, traffic, the time after the step. Its
@@ -39,6 +39,8 @@ struct FrameContext {
   // The frame's lamps (light_set.hpp), once the renderer has made them: for the passes that light
   // what the lamp map does not hold (the rain's drops).
   const std::vector<Light>* lights = nullptr;
+  // What is drawn of the session's roads (world.hpp).
+  const World* world = nullptr;
 
   const sim::WindshieldState& water() const { return stepped().windshield; }
   const sim::RainState& rain() const { return stepped().rain; }
@@ -70,7 +72,6 @@ struct FrameResources {
 
 // Resources made once and shared by the passes.
 struct SharedResources {
-  sim::Track track;
   Texture noise;    // make_noise, repeat
   Texture asphalt;  // make_asphalt_relief, repeat, mipmapped
   FullscreenTriangle fullscreen;
@@ -78,7 +79,6 @@ struct SharedResources {
   Texture horizon;  // relief::road_reliefs' horizon maps, RG16F, a layer per azimuth and relief
   int horizon_directions = 0;
   std::shared_ptr<const relief::RoadReliefs> reliefs;
-  std::vector<sim::StreetLight> street_lights;  // the track's (sim/lights.hpp)
 };
 
 // Axis-aligned box against the view frustum's side and near planes.

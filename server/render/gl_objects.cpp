@@ -122,6 +122,15 @@ Mesh::Mesh(const MeshData& data)
       glVertexArrayAttribBinding(vao, 3 + a, 1);
     }
   }
+  if (!data.lanes.empty()) {
+    glCreateBuffers(1, ids);
+    lanes_ = Buffer(ids[0]);
+    glNamedBufferStorage(lanes_.id(), data.lanes.size() * sizeof(VertexLane), data.lanes.data(), 0);
+    glVertexArrayVertexBuffer(vao, 2, lanes_.id(), 0, sizeof(VertexLane));
+    glEnableVertexArrayAttrib(vao, 5);
+    glVertexArrayAttribFormat(vao, 5, 4, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(vao, 5, 2);
+  }
 }
 
 void Mesh::draw() const {

@@ -111,6 +111,7 @@ class Mesh {
   Buffer vbo_;
   Buffer ibo_;
   Buffer curvature_;
+  Buffer lanes_;
   GLsizei index_count_ = 0;
 };
 

@@ -1,9 +1,21 @@
 #include "server/render/mesh_data.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
 namespace downpour::render {
+
+float pack_lane_mark(int kind, bool yellow, double width_m, double offset_m, double spacing_m) {
+  auto cm = [](double m, int lo, int hi) {
+    return std::clamp(static_cast<int>(std::lround(m * 100.0)), lo, hi);
+  };
+  const int code = std::clamp(kind, 0, 7) | (yellow ? 8 : 0) | cm(width_m, 0, 63) << 4 |
+                   (cm(offset_m, -64, 63) + 64) << 10 | cm(spacing_m, 0, 127) << 17;
+  return static_cast<float>(code);
+}
 
 std::uint32_t MeshData::add_vertex(const glm::vec3& p, const glm::vec3& n, const glm::vec2& uv) {
   vertices.push_back({p, n, uv});

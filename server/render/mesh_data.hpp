@@ -6,6 +6,7 @@
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 namespace downpour::render {
 
@@ -24,9 +25,29 @@ struct VertexCurvature {
   glm::vec2 v2{0.0f, 1.0f};
 };
 
+// Where a road vertex lies among its road's lanes (scene_geometry.hpp), a third vertex stream:
+// attribute 5, flat (from each triangle's provoking vertex). The road's vertices stand in columns
+// along it, at every lane border and across the verges; a column's attributes describe the strip
+// between it and the next column to its left.
+struct VertexLane {
+  float t = 0.0f;  // the column's lateral offset on its road (m, left positive)
+  // The strip's width (m), + 100 on a lane cars drive in; on a verge -1000 right of the road,
+  // 1000 left of it, and `t` the paved edge's.
+  float width = 1.0f;
+  // The marks on the strip's right and left borders, packed (pack_lane_mark).
+  float mark_right = 0.0f;
+  float mark_left = 0.0f;
+};
+
+// A lane mark in one float, an integer below 2^24 (road_surface.glsl unpacks it): bits 0-2 the
+// kind (sim::LaneMark::Kind), 3 yellow, 4-9 one line's width (cm), 10-16 its centre's offset from
+// the border (cm, + 64; left positive), 17-23 a double line's spacing (cm).
+float pack_lane_mark(int kind, bool yellow, double width_m, double offset_m, double spacing_m);
+
 struct MeshData {
   std::vector<MeshVertex> vertices;
   std::vector<VertexCurvature> curvature;  // empty, or one a vertex
+  std::vector<VertexLane> lanes;           // empty, or one a vertex
   std::vector<std::uint32_t> indices;
   glm::vec3 bounds_min{1e30f};
   glm::vec3 bounds_max{-1e30f};

@@ -35,6 +35,7 @@
 #include "server/render/procedural_textures.hpp"
 #include "server/render/relief.hpp"
 #include "server/render/shader_interface.hpp"
+#include "server/render/world.hpp"
 #include "server/sim/pose.hpp"
 
 namespace downpour::render {
@@ -165,15 +166,15 @@ Mirror mirror_in(const glm::dvec4& plane) {
   return m;
 }
 
-Mirror mirror_under(const sim::Track& track, const sim::VehicleState& vehicle) {
+Mirror mirror_under(const sim::RoadNetwork& roads, const sim::VehicleState& vehicle) {
   const glm::dvec2 xy(vehicle.position_m);
-  const sim::Track::Projection p = track.project(xy, 50.0);
-  const sim::TrackFrame f = track.at(p.s);
+  const sim::RoadPlace p = roads.project(xy, 50.0);
+  const sim::TrackFrame f = roads.frame(p.road, p.s);
   const glm::dvec3 along =
       glm::normalize(glm::dvec3(std::cos(f.heading_rad), std::sin(f.heading_rad), f.grade));
   glm::dvec3 n = glm::normalize(glm::cross(along, glm::dvec3(f.left, 0.0)));
   if (n.z < 0.0) n = -n;
-  const glm::dvec3 point(xy, track.surface_height(p.s, p.lateral));
+  const glm::dvec3 point(xy, roads.surface_height(p));
   return mirror_in(glm::dvec4(n, -glm::dot(n, point)));
 }
 
@@ -223,6 +224,7 @@ RenderSession::~RenderSession() = default;
 struct Renderer::Impl {
   std::unique_ptr<EglContext> context;
   std::unique_ptr<SharedResources> shared;
+  Worlds worlds;  // what is drawn of each road network
   Buffer frame_ubo;
   // The frame's lamps: their block (binding kLampBlockBinding), the map of their light on the
   // ground, and the frame block's fields that place it.
@@ -454,6 +456,7 @@ struct Renderer::Impl {
     FrameContext mf{f.scene, f.spec,   mirrored, f.atmosphere, f.vehicle_to_world,
                     f.glass, f.stepped};
     mf.detail_distance_scale = kReflectionScale;
+    mf.world = f.world;
     WaterBlock clip;
     upload_frame_block(mf, clip);
     glBindFramebuffer(GL_FRAMEBUFFER, t.fbo.id());
@@ -563,7 +566,7 @@ struct Renderer::Impl {
     // still show (vehicle.frag).
     constexpr float kLampsFromExposure = 2e-4f;
     if (lamps_on && f.atmosphere.lux_exposure >= kLampsFromExposure)
-      frame_lights = build_lights(f.scene, shared->street_lights, f.camera.position);
+      frame_lights = build_lights(f.scene, f.world->street_lights, f.camera.position);
     f.lights = &frame_lights;
     const std::vector<Light>& lights = frame_lights;
     const glm::mat4& view = f.camera.view;
@@ -611,11 +614,12 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   glClearDepthf(0.0f);
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
 
-  impl->shared = std::make_unique<SharedResources>(SharedResources{
-      sim::Track::built_in(), upload_repeating(make_noise(256, 1), true),
-      upload_repeating(make_asphalt_relief(512, 2), true), FullscreenTriangle(), Texture(),
-      Texture(), 0, nullptr, sim::street_lights(sim::Track::built_in())});
+  impl->shared = std::make_unique<SharedResources>(
+      SharedResources{upload_repeating(make_noise(256, 1), true),
+                      upload_repeating(make_asphalt_relief(512, 2), true), FullscreenTriangle(),
+                      Texture(), Texture(), 0, nullptr});
   upload_reliefs(*impl->shared, relief::road_reliefs(kHorizonDirections));
+  impl->worlds.get(nullptr);  // the built-in track's, before the first frame
   glBindTextureUnit(texture_unit::kNoise, impl->shared->noise.id());
   glBindTextureUnit(texture_unit::kAsphalt, impl->shared->asphalt.id());
   glBindTextureUnit(texture_unit::kSetts, impl->shared->setts.id());
@@ -747,6 +751,7 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
                      glm::mat4(sim::vehicle_to_world(scene.vehicle)),
                      GlassView(camera, scene.glass, spec.height),
                      stepped};
+  frame.world = &m.worlds.get(scene.roads);
   FrameResources resources;
   resources.view_fbo = target->fbo.id();
   resources.view_colour = {target->colour.id(), spec.width, spec.height};
@@ -761,7 +766,8 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
   ++m.frame;
   m.evict_transients();
   m.written.fill(false);
-  const Mirror mirror = mirror_under(m.shared->track, scene.vehicle);
+  const Mirror mirror =
+      mirror_under(scene.roads ? *scene.roads : *sim::built_in_roads(), scene.vehicle);
   const bool reflection =
       m.reads_reflection[static_cast<int>(spec.view)] && Impl::road_reflects(frame);
   // Profiling: the clears and the frame's uploads finish here, not in the first step's time.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -30,49 +31,97 @@ double hills(double x, double y) {
 
 namespace {
 
-// The road in chunks of chunk_length_m with cross-sections every step_m.
-std::vector<MeshData> road_chunks(const sim::Track& track, double chunk_length_m, double step) {
-  const double half = track.paved_half_width();
-  // Lateral stations of the cross-section, left positive: the verge's every metre, so that its
-  // rounded fall (below) is a curve the mesh's curvature can be taken from.
-  const double lanes = track.cross_section().lanes_each_way * track.cross_section().lane_width_m;
-  std::vector<double> stations = {-lanes, 0.0, lanes};
-  for (double t = 0.0; t <= kVerge + 1e-9; t += kVerge / 4.0) {
-    stations.insert(stations.begin(), -half - t);
-    stations.push_back(half + t);
-  }
-  std::vector<MeshData> chunks;
-  const int rows_total = static_cast<int>(std::ceil(track.length() / step));
-  const int rows_per_chunk = std::max(1, static_cast<int>(chunk_length_m / step));
-  for (int first = 0; first < rows_total; first += rows_per_chunk) {
+// A mark as the road shader reads it (mesh_data.hpp's VertexLane): its centre's offset signed by
+// its border's side of the centre lane (side: -1 right, 1 left, 0 the centre).
+float mark_attribute(const sim::LaneMark& m, int side) {
+  return pack_lane_mark(static_cast<int>(m.kind), m.yellow, m.width_m, side * m.offset_m,
+                        m.spacing_m);
+}
+
+// The cross-slope (dz/dt) of a road's surface at t, from its heights either side, inward only at
+// the paved width's edges.
+double cross_slope(const sim::RoadNetwork& roads, int road, double s, double t,
+                   const sim::PavedSpan& span) {
+  constexpr double e = 0.05;
+  const double lo = std::max(t - e, span.right), hi = std::min(t + e, span.left);
+  if (hi - lo < 1e-6) return 0.0;
+  return (roads.surface_height({road, s, hi}) - roads.surface_height({road, s, lo})) / (hi - lo);
+}
+
+// One lane section of a road, [s0, s1), in chunks of chunk_length_m with cross-sections every
+// step_m: a column of vertices at every lane border, and a verge beyond each paved edge. Each
+// column's flat attributes describe the strip to its left (VertexLane), the provoking vertex of
+// both of the strip's triangles.
+void road_piece(const sim::RoadNetwork& roads, int road, double s0, double s1,
+                double chunk_length_m, double step, std::vector<MeshData>& chunks) {
+  constexpr int kVergeStations = 5;  // the edge, then every metre
+  for (double c0 = s0; c0 < s1 - 1e-6; c0 += chunk_length_m) {
+    const double c1 = std::min(c0 + chunk_length_m, s1);
+    std::vector<double> rows;
+    for (double s = c0; s < c1 - 1e-6; s += step) rows.push_back(s);
+    rows.push_back(c1);
     MeshData m;
-    const int last = std::min(rows_total, first + rows_per_chunk);
-    for (int row = first; row <= last; ++row) {
-      const double s = std::min(row * step, track.length());
-      const sim::TrackFrame f = track.at(s);
-      for (double lat : stations) {
-        const double clamped = std::clamp(lat, -half, half);
-        const double t = std::max(std::abs(lat) - half, 0.0) / kVerge;
-        // The verge rounds over from the pavement's edge: level there, falling ever faster.
-        const double z = track.surface_height(s, clamped) - kVergeDrop * t * t;
-        const glm::dvec2 xy = glm::dvec2(f.position) + f.left * lat;
-        // Normal from the cross-slope and the grade.
-        const double cross = std::abs(lat) < 1e-9
-                                 ? 0.0
-                                 : (std::abs(lat) <= half ? track.cross_section().crown_slope
-                                                          : 2.0 * kVergeDrop * t / kVerge) *
-                                       (lat > 0 ? -1.0 : 1.0);
-        const glm::dvec3 forward(std::cos(f.heading_rad), std::sin(f.heading_rad), f.grade);
-        const glm::dvec3 side(f.left.x, f.left.y, cross);
+    int per_row = 0;
+    for (const double s : rows) {
+      const sim::TrackFrame f = roads.frame(road, s);
+      const sim::LaneLayout layout = roads.lanes(road, s);
+      const sim::PavedSpan span{layout.right(), layout.left()};
+      const glm::dvec3 forward(std::cos(f.heading_rad), std::sin(f.heading_rad), f.grade);
+      const std::size_t first = m.vertices.size();
+      constexpr float kVergeStrip = 1000.0f, kDriving = 100.0f;  // VertexLane's width codes
+      auto vertex = [&](double t, double z, double slope, VertexLane lane) {
+        const glm::dvec2 xy = glm::dvec2(f.position) + f.left * t;
+        const glm::dvec3 side(f.left.x, f.left.y, slope);
         const glm::dvec3 n = glm::normalize(glm::cross(forward, side));
-        m.add_vertex(glm::vec3(xy.x, xy.y, z), glm::vec3(n), glm::vec2(lat, s));
+        m.add_vertex(glm::vec3(xy.x, xy.y, z), glm::vec3(n), glm::vec2(t, s));
+        m.lanes.push_back(lane);
+      };
+      // The verges round over from the pavement's edge: level there, falling ever faster. None
+      // where another road's pavement lies beyond the edge (the other direction's lanes on a road
+      // of one-way halves, a junction): its stations all at the edge, its triangles empty.
+      auto verge = [&](double edge, double way) {
+        const double z = roads.surface_height({road, s, edge});
+        const glm::dvec2 beyond = glm::dvec2(f.position) + f.left * (edge + way * 0.5);
+        const sim::RoadPlace other = roads.project(beyond, 30.0);
+        const bool covered =
+            other.road != road && roads.paved(other.road, other.s).contains(other.t);
+        for (int k = 1; k < kVergeStations; ++k) {
+          const int station = covered ? 0 : way > 0.0 ? k : kVergeStations - k;
+          const double u = station * (kVerge / (kVergeStations - 1)) / kVerge;
+          const double slope = -way * 2.0 * kVergeDrop * u / kVerge;
+          vertex(edge + way * u * kVerge, z - kVergeDrop * u * u, slope,
+                 VertexLane{static_cast<float>(edge), static_cast<float>(way) * kVergeStrip, 0.0f,
+                            0.0f});
+        }
+      };
+      verge(span.right, -1.0);
+      const int centre = layout.centre;
+      for (std::size_t b = 0; b < layout.borders.size(); ++b) {
+        const double t = layout.borders[b];
+        // (The last border's strip: the left verge.)
+        VertexLane attr{static_cast<float>(t), kVergeStrip, 0.0f, 0.0f};
+        if (b + 1 < layout.borders.size()) {
+          const auto right = static_cast<int>(b), left = right + 1;
+          attr.width =
+              static_cast<float>(layout.borders[b + 1] - t) + (layout.driving[b] ? kDriving : 0.0f);
+          attr.mark_right =
+              mark_attribute(layout.marks[right], (right > centre) - (right < centre));
+          attr.mark_left = mark_attribute(layout.marks[left], (left > centre) - (left < centre));
+        }
+        vertex(t, roads.surface_height({road, s, t}), cross_slope(roads, road, s, t, span), attr);
       }
+      verge(span.left, 1.0);
+      per_row = static_cast<int>(m.vertices.size() - first);
     }
-    const int cols = static_cast<int>(stations.size());
-    for (int r = 0; r < last - first; ++r) {
-      for (int c = 0; c + 1 < cols; ++c) {
-        const auto i = static_cast<std::uint32_t>(r * cols + c);
-        m.add_quad(i, i + 1, i + 1 + cols, i + cols);
+    // Each quad's two triangles end on its right column's vertices (OpenGL's provoking vertex is
+    // a triangle's last): (i + 1, i + 1 + n, i) and (i + 1 + n, i + n, i), counter-clockwise as
+    // (i, i + 1, i + 1 + n, i + n) is.
+    for (std::size_t r = 0; r + 1 < rows.size(); ++r) {
+      for (int c = 0; c + 1 < per_row; ++c) {
+        const auto i = static_cast<std::uint32_t>(r * per_row + c);
+        const auto n = static_cast<std::uint32_t>(per_row);
+        m.add_triangle(i + 1, i + 1 + n, i);
+        m.add_triangle(i + 1 + n, i + n, i);
       }
     }
     // For the relief shadows' correction (seed 002): the crests of the road's profile, the
@@ -80,15 +129,24 @@ std::vector<MeshData> road_chunks(const sim::Track& track, double chunk_length_m
     m.curvature = vertex_curvatures(m);
     chunks.push_back(std::move(m));
   }
-  return chunks;
 }
 
 }  // namespace
 
-std::vector<std::vector<MeshData>> build_road_chunks(const sim::Track& track) {
-  // Every level's chunks start and end at the same cross-sections (steps divide the length).
-  std::vector<std::vector<MeshData>> levels;
-  for (double step : kRoadStepsM) levels.push_back(road_chunks(track, kRoadChunkM, step));
+std::vector<std::vector<MeshData>> build_road_chunks(const sim::RoadNetwork& roads) {
+  // Every level's chunks start and end at the same cross-sections.
+  std::vector<std::vector<MeshData>> levels(std::size(kRoadStepsM));
+  for (int road = 0; road < roads.road_count(); ++road) {
+    const std::vector<double> starts = roads.section_starts(road);
+    const double length = roads.road_length(road);
+    for (std::size_t i = 0; i < starts.size(); ++i) {
+      const double s0 = starts[i], s1 = i + 1 < starts.size() ? starts[i + 1] : length;
+      if (s1 - s0 < 1e-3) continue;
+      for (std::size_t l = 0; l < levels.size(); ++l) {
+        road_piece(roads, road, s0, s1, kRoadChunkM, kRoadStepsM[l], levels[l]);
+      }
+    }
+  }
   std::vector<std::vector<MeshData>> chunks(levels.front().size());
   for (auto& level : levels) {
     for (std::size_t c = 0; c < chunks.size(); ++c) chunks[c].push_back(std::move(level[c]));
@@ -96,38 +154,50 @@ std::vector<std::vector<MeshData>> build_road_chunks(const sim::Track& track) {
   return chunks;
 }
 
-double terrain_height(const sim::Track& track, double x, double y) {
-  const sim::Track::Projection p = track.project({x, y}, 150.0);
-  const double half = track.paved_half_width();
-  const double edge = track.surface_height(p.s, std::copysign(half, p.lateral)) - kVergeDrop - 0.15;
-  const double d = std::abs(p.lateral) - half - kVerge;
-  // Far from the track the ground rises to a ring of low mountains.
-  const glm::dvec2 centre(450.0, 250.0);
+double terrain_height(const sim::RoadNetwork& roads, double x, double y) {
+  const sim::RoadPlace p = roads.project({x, y}, 150.0);
+  const sim::PavedSpan span = roads.paved(p.road, p.s);
+  const double mid = 0.5 * (span.left + span.right);
+  const double edge_t = p.t >= mid ? span.left : span.right;
+  const double edge = roads.surface_height({p.road, p.s, edge_t}) - kVergeDrop - 0.15;
+  const double d = std::abs(p.t - mid) - 0.5 * (span.left - span.right) - kVerge;
+  // Far from the roads the ground rises to a ring of low mountains.
+  glm::dvec2 lo, hi;
+  roads.bounds(lo, hi);
+  const glm::dvec2 centre = 0.5 * (lo + hi);
+  const double ring = std::max(1000.0, 0.5 * glm::length(hi - lo) + 200.0);
   const double r = glm::length(glm::dvec2(x, y) - centre);
   const double far_hills =
-      70.0 * glm::smoothstep(1000.0, 1800.0, r) * (0.7 + 0.3 * std::sin(x / 300.0 + y / 410.0));
-  const double natural = edge + hills(x, y) + far_hills;
+      70.0 * glm::smoothstep(ring, ring + 800.0, r) * (0.7 + 0.3 * std::sin(x / 300.0 + y / 410.0));
+  // (Around a simulator's roads, level fields a little below them, up to the far ring.)
+  const double natural =
+      edge + far_hills + (roads.own_scenery() ? hills(x, y) : -0.02 * std::min(d, 50.0));
   const double blend = glm::smoothstep(0.0, 60.0, d);
   return glm::mix(std::min(edge, natural), natural, blend);
 }
 
-std::vector<std::vector<MeshData>> build_terrain_chunks(const sim::Track& track) {
-  // Bounds of the track plus a margin.
+std::vector<std::vector<MeshData>> build_terrain_chunks(const sim::RoadNetwork& roads) {
+  // Bounds of the roads' reference lines plus a margin.
   glm::dvec2 lo(1e30), hi(-1e30);
-  for (double s = 0.0; s < track.length(); s += 20.0) {
-    const glm::dvec2 p(track.at(s).position);
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
+  for (int road = 0; road < roads.road_count(); ++road) {
+    const double length = roads.road_length(road);
+    for (double s = 0.0; s < length; s += 20.0) {
+      const glm::dvec2 p(roads.frame(road, s).position);
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
   }
   lo -= kTerrainMargin;
   hi += kTerrainMargin;
-  const int nx = static_cast<int>(std::ceil((hi.x - lo.x) / kTerrainCell));
-  const int ny = static_cast<int>(std::ceil((hi.y - lo.y) / kTerrainCell));
+  // 20 m cells, coarser over a network so wide that they would be more than 1024 across.
+  const double cell = std::max(kTerrainCell, std::max(hi.x - lo.x, hi.y - lo.y) / 1024.0);
+  const int nx = static_cast<int>(std::ceil((hi.x - lo.x) / cell));
+  const int ny = static_cast<int>(std::ceil((hi.y - lo.y) / cell));
   std::vector<float> heights(static_cast<std::size_t>((nx + 1) * (ny + 1)));
   for (int j = 0; j <= ny; ++j) {
     for (int i = 0; i <= nx; ++i) {
-      heights[j * (nx + 1) + i] = static_cast<float>(
-          terrain_height(track, lo.x + i * kTerrainCell, lo.y + j * kTerrainCell));
+      heights[j * (nx + 1) + i] =
+          static_cast<float>(terrain_height(roads, lo.x + i * cell, lo.y + j * cell));
     }
   }
   auto h = [&](int i, int j) {
@@ -153,11 +223,11 @@ std::vector<std::vector<MeshData>> build_terrain_chunks(const sim::Track& track)
         const std::vector<int> is = samples(i0, i1, step), js = samples(j0, j1, step);
         MeshData m;
         auto vertex = [&](int i, int j, float drop) {
-          const float x = static_cast<float>(lo.x + i * kTerrainCell);
-          const float y = static_cast<float>(lo.y + j * kTerrainCell);
+          const float x = static_cast<float>(lo.x + i * cell);
+          const float y = static_cast<float>(lo.y + j * cell);
           const glm::vec3 n =
               glm::normalize(glm::vec3(h(i - 1, j) - h(i + 1, j), h(i, j - 1) - h(i, j + 1),
-                                       2.0f * static_cast<float>(kTerrainCell)));
+                                       2.0f * static_cast<float>(cell)));
           return m.add_vertex({x, y, h(i, j) - drop}, n, {x, y});
         };
         for (int j : js) {
@@ -171,7 +241,7 @@ std::vector<std::vector<MeshData>> build_terrain_chunks(const sim::Track& track)
           }
         }
         // Skirts hanging from the edges hide the cracks where a neighbour is drawn finer.
-        const float drop = static_cast<float>(kSkirtDepthPerCell * step * kTerrainCell + 2.0);
+        const float drop = static_cast<float>(kSkirtDepthPerCell * step * cell + 2.0);
         auto skirt = [&](const std::vector<std::pair<int, int>>& edge) {
           for (std::size_t k = 0; k + 1 < edge.size(); ++k) {
             const std::uint32_t a = vertex(edge[k].first, edge[k].second, 0.0f);

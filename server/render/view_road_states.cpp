@@ -12,7 +12,7 @@
 #include "server/render/camera.hpp"
 #include "server/sim/car_body.hpp"
 #include "server/sim/pose.hpp"
-#include "server/sim/track.hpp"
+#include "server/sim/road_network.hpp"
 
 namespace downpour::render {
 
@@ -81,23 +81,23 @@ RoadStateFractions view_road_states(const sim::ViewSpec& spec, const sim::SceneS
     return out;
   }
   const sim::RoadWaterImage* image = scene.road_water.get();
-  const sim::Track& track = sim::Track::built_in();
+  const sim::RoadNetwork& roads = scene.roads ? *scene.roads : *sim::built_in_roads();
   const Camera camera = make_camera(spec, scene.vehicle);
   const glm::dmat4 inverse = glm::inverse(glm::dmat4(camera.projection * camera.view));
   const glm::dvec3 eye(camera.position);
   // The road's plane under the car: its height there, level (the correction below adds the rest).
   const glm::dvec2 car(scene.vehicle.position_m);
-  const sim::Track::Projection under = track.project(car, 50.0);
-  const double ground = track.surface_height(under.s, under.lateral);
+  const sim::RoadPlace under = roads.project(car, 50.0);
+  const double ground = roads.surface_height(under);
   sim::RoadWaterConfig thresholds;
   if (image) thresholds.capacity_m = image->capacity_mm * 1e-3;
   constexpr int kColumns = 64, kRows = 36;
   const std::vector<Box> boxes = occluders(spec, scene);
   int counts[4] = {0, 0, 0, 0};
   for (int row = 0; row < kRows; ++row) {
-    // Neighbouring rays land near each other: each one's place on the track starts from the last
+    // Neighbouring rays land near each other: each one's place on the roads starts from the last
     // one's (a few Newton steps), the first of a row from the car's.
-    double s_guess = under.s;
+    sim::RoadPlace guess = under;
     for (int col = 0; col < kColumns; ++col) {
       const glm::dvec4 p = inverse * glm::dvec4((col + 0.5) / kColumns * 2.0 - 1.0,
                                                 1.0 - (row + 0.5) / kRows * 2.0, 0.5, 1.0);
@@ -105,13 +105,13 @@ RoadStateFractions view_road_states(const sim::ViewSpec& spec, const sim::SceneS
       if (dir.z > -1e-4) continue;  // the sky
       double t = (ground - eye.z) / dir.z;
       if (t <= 0.0 || t > kFarM) continue;
-      sim::Track::Projection at = track.project_near(glm::dvec2(eye + dir * t), s_guess);
-      t = (track.surface_height(at.s, at.lateral) - eye.z) / dir.z;
+      sim::RoadPlace at = roads.project_near(glm::dvec2(eye + dir * t), guess);
+      t = (roads.surface_height(at) - eye.z) / dir.z;
       if (t <= 0.0 || t > kFarM) continue;
       const glm::dvec3 hit = eye + dir * t;
-      at = track.project_near(glm::dvec2(hit), at.s);
-      s_guess = at.s;
-      if (std::abs(at.lateral) > track.paved_half_width()) continue;
+      at = roads.project_near(glm::dvec2(hit), at);
+      guess = at;
+      if (!roads.paved(at.road, at.s).contains(at.t)) continue;
       bool hidden = false;
       for (const Box& box : boxes) hidden = hidden || enters(box, eye, dir) < t;
       if (hidden) continue;

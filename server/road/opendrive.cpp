@@ -534,6 +534,11 @@ class Parser {
       fail(node, "length " + std::to_string(road.length) + " is not in (0, " +
                      std::to_string(limits_.max_road_length_m) + "] m");
     }
+    total_length_ += road.length;
+    if (total_length_ > limits_.max_total_length_m) {
+      fail(node, "the roads' lengths add up to more than " +
+                     std::to_string(limits_.max_total_length_m) + " m");
+    }
     if (const pugi::xml_node l = node.child("link")) {
       road.predecessor = link(l.child("predecessor"));
       road.successor = link(l.child("successor"));
@@ -598,6 +603,7 @@ class Parser {
   Limits limits_;
   std::size_t records_ = 0;
   std::size_t knots_ = 0;
+  double total_length_ = 0.0;
 };
 
 }  // namespace

@@ -156,6 +156,8 @@ struct Limits {
   std::size_t max_records = 2'000'000;  // geometry, lane, width, mark and profile records in all
   std::size_t max_lanes_per_side = 32;
   double max_road_length_m = 100'000.0;
+  // All roads' together: the scene built from them (a mesh row every few metres) is in proportion.
+  double max_total_length_m = 200'000.0;
   double max_coordinate_m = 1e7;  // |x|, |y|
   // Any number at all (so that a cubic over a road's length stays finite).
   double max_number = 1e9;

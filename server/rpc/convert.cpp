@@ -70,6 +70,8 @@ void fill_session_info(const session::Session& session, v1::SessionInfo* out) {
   out->set_mode(c.mode == sim::Mode::kLockstep ? v1::MODE_LOCKSTEP : v1::MODE_REALTIME);
   out->set_fps(c.fps);
   out->set_seed(c.seed);
+  out->set_road_network(c.road_network);
+  out->set_roads(static_cast<std::uint32_t>(c.roads ? c.roads->road_count() : 1));
   for (const sim::ViewSpec& v : c.views) {
     v1::ViewSpec* spec = out->add_views();
     spec->set_view(to_proto(v.view));

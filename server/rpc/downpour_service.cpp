@@ -491,9 +491,10 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::Frame>,
 
 DownpourService::DownpourService(session::SessionRegistry& registry,
                                  session::FrameScheduler& scheduler, Limits limits,
-                                 Authenticator auth)
+                                 Authenticator auth, std::shared_ptr<RoadNetworks> road_networks)
     : scheduler_(scheduler),
-      context_{registry, limits, std::move(auth)},
+      context_{registry, limits, std::move(auth),
+               road_networks ? std::move(road_networks) : std::make_shared<RoadNetworks>()},
       started_(std::chrono::steady_clock::now()) {}
 
 grpc::ServerUnaryReactor* DownpourService::CreateSession(grpc::CallbackServerContext* ctx,
@@ -511,13 +512,20 @@ grpc::ServerUnaryReactor* DownpourService::CreateSession(grpc::CallbackServerCon
   if (auto s = to_session_config(*request, context_.limits, &config, &initial); !s.ok())
     return finish(ctx, s);
   config.owner = who.name;
+  LoadedRoads roads;
+  if (auto s = context_.road_networks->load(request->roads(), "roads", &roads); !s.ok())
+    return finish(ctx, s);
+  config.roads = std::move(roads.roads);
+  config.road_network = std::move(roads.name);
   std::string refusal;
   auto session = context_.registry.create(std::move(config), initial, &refusal);
   if (!session) return finish(ctx, grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, refusal));
   fill_session_info(*session, response);
-  spdlog::info("session {} started: {} mode, {} view(s), seed {}, by {} from {}", session->id(),
+  spdlog::info("session {} started: {} mode, {} view(s), seed {}, roads {}, by {} from {}",
+               session->id(),
                session->config().mode == sim::Mode::kLockstep ? "lockstep" : "realtime",
-               session->config().views.size(), session->config().seed, who.name, ctx->peer());
+               session->config().views.size(), session->config().seed,
+               session->config().road_network, who.name, ctx->peer());
   return finish(ctx, grpc::Status::OK);
 }
 

@@ -6,6 +6,7 @@
 
 #include "downpour/v1/downpour.grpc.pb.h"
 #include "server/rpc/auth.hpp"
+#include "server/rpc/road_networks.hpp"
 #include "server/rpc/validation.hpp"
 #include "server/session/frame_scheduler.hpp"
 #include "server/session/session_registry.hpp"
@@ -23,7 +24,8 @@ using ServiceBase = v1::Downpour::WithCallbackMethod_CreateSession<
 class DownpourService final : public ServiceBase {
  public:
   DownpourService(session::SessionRegistry& registry, session::FrameScheduler& scheduler,
-                  Limits limits, Authenticator auth = {});
+                  Limits limits, Authenticator auth = {},
+                  std::shared_ptr<RoadNetworks> road_networks = nullptr);
 
   grpc::ServerUnaryReactor* CreateSession(grpc::CallbackServerContext* ctx,
                                           const v1::CreateSessionRequest* request,
@@ -60,6 +62,7 @@ class DownpourService final : public ServiceBase {
     session::SessionRegistry& registry;
     Limits limits;
     Authenticator auth;
+    std::shared_ptr<RoadNetworks> road_networks;
     std::atomic<std::uint64_t> reader_drops{0};
     std::atomic<bool> draining{false};
     std::atomic<int> steps_in_flight{0};

@@ -4,13 +4,23 @@
 
 namespace downpour::session {
 
+namespace {
+
+sim::SimulationConfig simulation_config(const SessionConfig& config) {
+  sim::SimulationConfig c;
+  c.roads = config.roads;
+  return c;
+}
+
+}  // namespace
+
 Session::Session(std::string id, std::uint64_t number, SessionConfig config,
                  const sim::Update& initial, std::function<void()> wake_renderer)
     : id_(std::move(id)),
       number_(number),
       config_(std::move(config)),
       wake_renderer_(std::move(wake_renderer)),
-      simulation_(config_.seed, initial),
+      simulation_(config_.seed, initial, simulation_config(config_)),
       last_heard_(Clock::now().time_since_epoch().count()) {}
 
 void Session::touch() { last_heard_ = Clock::now().time_since_epoch().count(); }

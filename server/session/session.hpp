@@ -26,6 +26,9 @@ struct SessionConfig {
   double fps = 30.0;
   std::uint64_t seed = 0;
   std::string owner;  // the principal that created it (rpc/auth.hpp); it alone drives it
+  // Its roads (sim/road_network.hpp): null, the built-in track; and what the client named them.
+  std::shared_ptr<const sim::RoadNetwork> roads;
+  std::string road_network = "built-in track";
 };
 
 struct StepOutcome {

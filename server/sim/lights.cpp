@@ -48,30 +48,44 @@ void VehicleMotion::observe(const VehicleState& state, double now_s, const Light
   known = true;
 }
 
-std::vector<StreetLight> street_lights(const Track& track, const LightsConfig& c) {
+std::vector<StreetLight> street_lights(const RoadNetwork& roads, const LightsConfig& c) {
   std::vector<StreetLight> out;
-  const double half = track.paved_half_width();
-  const int n =
-      std::max(1, static_cast<int>(std::floor(track.length() / c.street_light_spacing_m)));
-  for (int i = 0; i < n; ++i) {
-    const double s = track.length() * i / n;
-    const TrackFrame f = track.at(s);
-    const int side = i % 2 == 0 ? 1 : -1;
-    const double pole_lat = side * (half + c.street_light_setback_m);
-    const double lamp_lat = pole_lat - side * c.street_light_arm_m;
-    StreetLight l;
-    l.s = s;
-    l.side = side;
-    const glm::dvec2 foot = glm::dvec2(f.position) + f.left * pole_lat;
-    const glm::dvec2 lamp = glm::dvec2(f.position) + f.left * lamp_lat;
-    const double edge_z = track.surface_height(s, side * half);
-    l.foot_m = {foot.x, foot.y, edge_z};
-    l.lamp_m = {
-        lamp.x, lamp.y,
-        track.surface_height(s, std::clamp(lamp_lat, -half, half)) + c.street_light_height_m};
-    out.push_back(l);
+  for (int road = 0; road < roads.road_count(); ++road) {
+    if (roads.connecting(road)) continue;
+    const double length = roads.road_length(road);
+    const bool loops = roads.road_loops(road);
+    // Around a loop from its start; along a road, centred on it (none on one shorter than the
+    // spacing); none whose pole would stand on a road.
+    const int n = static_cast<int>(std::floor(length / c.street_light_spacing_m));
+    for (int i = 0; i < n; ++i) {
+      const double s = length * (loops ? i : i + 0.5) / n;
+      const TrackFrame f = roads.frame(road, s);
+      const PavedSpan span = roads.paved(road, s);
+      const int side = i % 2 == 0 ? 1 : -1;
+      const double edge = side > 0 ? span.left : span.right;
+      const double pole_lat = edge + side * c.street_light_setback_m;
+      const double lamp_lat = pole_lat - side * c.street_light_arm_m;
+      StreetLight l;
+      l.road = road;
+      l.s = s;
+      l.side = side;
+      const glm::dvec2 foot = glm::dvec2(f.position) + f.left * pole_lat;
+      const glm::dvec2 lamp = glm::dvec2(f.position) + f.left * lamp_lat;
+      // Not on another road (beside a junction, or a road running alongside).
+      const RoadPlace under = roads.project(foot, 30.0);
+      if (under.road != road && roads.paved(under.road, under.s).contains(under.t)) continue;
+      l.foot_m = {foot.x, foot.y, roads.surface_height({road, s, edge})};
+      l.lamp_m = {lamp.x, lamp.y,
+                  roads.surface_height({road, s, std::clamp(lamp_lat, span.right, span.left)}) +
+                      c.street_light_height_m};
+      out.push_back(l);
+    }
   }
   return out;
+}
+
+std::vector<StreetLight> street_lights(const Track& track, const LightsConfig& config) {
+  return street_lights(TrackRoads(track), config);
 }
 
 bool street_lights_on(const Weather& w, const LightsConfig& c) {

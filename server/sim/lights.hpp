@@ -8,7 +8,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "server/sim/track.hpp"
+#include "server/sim/road_network.hpp"
 #include "server/sim/types.hpp"
 
 namespace downpour::sim {
@@ -25,7 +25,7 @@ struct LightsConfig {
   // Indicators and hazard lights: flashes per second, lit half of each (ECE R48: 90 +- 30 a
   // minute).
   double indicator_hz = 1.5;
-  // Street lights: one about every spacing_m along the track, on each side in turn, the pole set
+  // Street lights: one about every spacing_m along each road, on each side in turn, the pole set
   // back from the pavement's edge, the lamp at the end of an arm over the road; lit below this
   // sun, or under a sky this overcast with the sun below 25 degrees.
   double street_light_spacing_m = 25.0;
@@ -61,10 +61,12 @@ struct VehicleMotion {
 struct StreetLight {
   glm::dvec3 lamp_m{0.0};  // world: the lamp
   glm::dvec3 foot_m{0.0};  // world: the pole's foot
-  double s = 0.0;          // along the track
+  int road = 0;            // the road it stands beside (road_network.hpp)
+  double s = 0.0;          // along it
   int side = 1;            // 1 left of the direction of travel, -1 right
 };
-// The track's street lights, in order along it.
+// The roads' street lights (none in junctions), in order along each road.
+std::vector<StreetLight> street_lights(const RoadNetwork& roads, const LightsConfig& config = {});
 std::vector<StreetLight> street_lights(const Track& track, const LightsConfig& config = {});
 bool street_lights_on(const Weather& weather, const LightsConfig& config = {});
 

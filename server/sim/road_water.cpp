@@ -46,7 +46,7 @@ RoadWater::RoadWater(const RoadSurface& surface, RoadWaterConfig config)
   const std::size_t count = static_cast<std::size_t>(levels_) * n_ * n_;
   ground_.assign(count, 0.0);
   water_.assign(count, 0.0);
-  track_s_.assign(count, 0.0);
+  places_.assign(count, RoadPlace{});
   hollow_.assign(count, 0.0);
   paved_.assign(count, 0);
   owned_.assign(count, 0);
@@ -69,15 +69,15 @@ std::array<glm::ivec2, kRoadWaterMaxLevels> RoadWater::ring_origins(glm::dvec2 c
   return out;
 }
 
-void RoadWater::sample(int level, glm::ivec2 cell, std::size_t c, double s_guess) {
+void RoadWater::sample(int level, glm::ivec2 cell, std::size_t c, const RoadPlace& guess) {
   const double size = cell_m(level);
   const glm::dvec2 xy = (glm::dvec2(cell) + 0.5) * size;
-  const Track::Projection p = surface_.project_near(xy, s_guess);
-  track_s_[c] = p.s;
-  paved_[c] = surface_.paved(p.lateral);
+  const RoadPlace p = surface_.project_near(xy, guess);
+  places_[c] = p;
+  paved_[c] = surface_.paved(p);
   if (level == 0) {
-    ground_[c] = surface_.height_at(p.s, p.lateral);
-    hollow_[c] = held_at(p.s, p.lateral);
+    ground_[c] = surface_.height_at(p);
+    hollow_[c] = held_at(p);
     return;
   }
   // A coarse cell: the section's height at its centre, and the mean of what the hollows hold
@@ -85,26 +85,25 @@ void RoadWater::sample(int level, glm::ivec2 cell, std::size_t c, double s_guess
   // the road, ruts change slowly).
   const int points = 4 << (level - 1);
   double sum = 0.0;
-  if (paved_[c] || surface_.paved(p.lateral - 0.5 * size) ||
-      surface_.paved(p.lateral + 0.5 * size)) {
+  if (paved_[c] || surface_.paved({p.road, p.s, p.t - 0.5 * size}) ||
+      surface_.paved({p.road, p.s, p.t + 0.5 * size})) {
     for (int k = 0; k < points; ++k) {
       const double u = ((k + 0.5) / points - 0.5) * size;
-      sum += held_at(p.s, p.lateral + u);
+      sum += held_at({p.road, p.s, p.t + u});
     }
   }
   hollow_[c] = sum / points;
-  ground_[c] = surface_.height_at(p.s, p.lateral) - surface_.relief(p.s, p.lateral);
+  ground_[c] = surface_.roads().surface_height(p);
 }
 
-double RoadWater::held_at(double s, double lateral) const {
+double RoadWater::held_at(const RoadPlace& place) const {
   // Water at a point stays if the ground rises either way across the road: the highest ground
   // within a metre each way is that way's rim, and the lower rim is where it spills. (A rut across
   // the crown's slope holds what lies below its lower lip. Along the road it runs with the grade,
   // but a rut is fed along its whole length as it runs, so it stays full.)
-  if (!surface_.paved(lateral)) return 0.0;
-  // (Across the road at one s: the track's elevation is common to all, so left out.)
-  const Track& track = surface_.track();
-  auto height = [&](double u) { return track.section_height(u) + surface_.relief(s, u); };
+  if (!surface_.paved(place)) return 0.0;
+  auto height = [&](double u) { return surface_.height_at({place.road, place.s, u}); };
+  const double lateral = place.t;
   const double here = height(lateral);
   double spill = 1e300;
   for (const double way : {1.0, -1.0}) {
@@ -120,16 +119,16 @@ void RoadWater::sample_window(int level) {
   // track, the middle one's from a search of the whole track.
   const int n = n_, m = n / 2;
   const glm::dvec2 middle = (glm::dvec2(origins_[level] + glm::ivec2(m)) + 0.5) * cell_m(level);
-  auto at = [&](int i, int j, double guess) {
+  auto at = [&](int i, int j, const RoadPlace& guess) {
     sample(level, origins_[level] + glm::ivec2(i, j), flat(level, i, j), guess);
   };
-  at(m, m, surface_.track().project(middle, 40.0).s);
-  for (int i = m + 1; i < n; ++i) at(i, m, track_s_[flat(level, i - 1, m)]);
-  for (int i = m - 1; i >= 0; --i) at(i, m, track_s_[flat(level, i + 1, m)]);
+  at(m, m, surface_.roads().project(middle, 40.0));
+  for (int i = m + 1; i < n; ++i) at(i, m, places_[flat(level, i - 1, m)]);
+  for (int i = m - 1; i >= 0; --i) at(i, m, places_[flat(level, i + 1, m)]);
   for (int j = m + 1; j < n; ++j)
-    for (int i = 0; i < n; ++i) at(i, j, track_s_[flat(level, i, j - 1)]);
+    for (int i = 0; i < n; ++i) at(i, j, places_[flat(level, i, j - 1)]);
   for (int j = m - 1; j >= 0; --j)
-    for (int i = 0; i < n; ++i) at(i, j, track_s_[flat(level, i, j + 1)]);
+    for (int i = 0; i < n; ++i) at(i, j, places_[flat(level, i, j + 1)]);
 }
 
 void RoadWater::settle(Record& r) {
@@ -283,10 +282,10 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
   }
   old_origins_ = origins_;
   origins_ = origins;
-  old_ground_.swap(ground_), old_water_.swap(water_), old_track_s_.swap(track_s_);
+  old_ground_.swap(ground_), old_water_.swap(water_), old_places_.swap(places_);
   old_hollow_.swap(hollow_), old_paved_.swap(paved_), old_owned_.swap(owned_);
   const std::size_t count = old_water_.size();
-  ground_.assign(count, 0.0), water_.assign(count, 0.0), track_s_.assign(count, 0.0);
+  ground_.assign(count, 0.0), water_.assign(count, 0.0), places_.assign(count, RoadPlace{});
   hollow_.assign(count, 0.0), paved_.assign(count, 0), owned_.assign(count, 0);
   // A level whose window stays, under a finer one that stays, keeps its cells as they are (the
   // finest windows move most often: most moves leave the coarse ones).
@@ -297,7 +296,7 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
     const std::size_t from = l * layer(), to = (l + 1) * layer();
     std::copy(old_ground_.begin() + from, old_ground_.begin() + to, ground_.begin() + from);
     std::copy(old_water_.begin() + from, old_water_.begin() + to, water_.begin() + from);
-    std::copy(old_track_s_.begin() + from, old_track_s_.begin() + to, track_s_.begin() + from);
+    std::copy(old_places_.begin() + from, old_places_.begin() + to, places_.begin() + from);
     std::copy(old_hollow_.begin() + from, old_hollow_.begin() + to, hollow_.begin() + from);
     std::copy(old_paved_.begin() + from, old_paved_.begin() + to, paved_.begin() + from);
     std::copy(old_owned_.begin() + from, old_owned_.begin() + to, owned_.begin() + from);
@@ -336,10 +335,10 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
         const glm::ivec2 near = glm::clamp(d, glm::ivec2(0), glm::ivec2(n - 1));
         const std::size_t oc = flat(l, near.x, near.y);
         if (near == d) {
-          ground_[c] = old_ground_[oc], paved_[c] = old_paved_[oc], track_s_[c] = old_track_s_[oc];
+          ground_[c] = old_ground_[oc], paved_[c] = old_paved_[oc], places_[c] = old_places_[oc];
           hollow_[c] = old_hollow_[oc];
         } else {
-          sample(l, q, c, old_track_s_[oc]);
+          sample(l, q, c, old_places_[oc]);
         }
       }
     }

@@ -190,11 +190,11 @@ class RoadWater {
   void move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origins);
   // A level's whole window from the surface.
   void sample_window(int level);
-  // A cell's ground, whether paved and its place along the track, from the surface (s_guess: a
-  // place along the track within a few metres).
-  void sample(int level, glm::ivec2 cell, std::size_t c, double s_guess);
+  // A cell's ground, whether paved and its place on the roads, from the surface (guess: a place
+  // within a few metres).
+  void sample(int level, glm::ivec2 cell, std::size_t c, const RoadPlace& guess);
   // How deep water stands at a point before it spills out of the relief's hollows (m).
-  double held_at(double s, double lateral) const;
+  double held_at(const RoadPlace& place) const;
   // The old windows' water over a level's cell that a finer ring held (m^3).
   double old_volume(int level, glm::ivec2 cell) const;
   // Shares volume_m3 out to cells of the new windows: the texture first, evenly, then a film of up
@@ -230,7 +230,7 @@ class RoadWater {
   double rain_m_ = 0.0;      // the rain that has fallen (m): the records take theirs by it
   std::vector<double> ground_, water_;
   std::vector<std::uint8_t> paved_, owned_;
-  std::vector<double> track_s_;  // each cell's centre's place along the track (the next's guess)
+  std::vector<RoadPlace> places_;  // each cell's centre's place on the roads (the next's guess)
   // What the relief's hollows hold under a cell (m of depth, held_at): at a finest cell's centre;
   // in a coarse cell, the mean over it, which it holds back from the flow (its ground is the
   // section's: the water in its ruts and bowls does not run).
@@ -242,7 +242,8 @@ class RoadWater {
   };
   std::vector<Crossing> crossings_;  // the edges across the rings' borders
   // move_to's, made once.
-  std::vector<double> old_ground_, old_water_, old_track_s_, old_hollow_;
+  std::vector<double> old_ground_, old_water_, old_hollow_;
+  std::vector<RoadPlace> old_places_;
   std::vector<std::uint8_t> old_paved_, old_owned_;
   std::array<glm::ivec2, kRoadWaterMaxLevels> old_origins_{};
   std::map<Source, std::vector<std::size_t>> shares_;

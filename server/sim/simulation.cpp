@@ -34,10 +34,12 @@ Simulation::Simulation(std::uint64_t seed, const Update& initial, SimulationConf
       rain_(seed, config.rain),
       water_map_(config.windshield.glass, config.water_map),
       blades_at_water_step_(wipers_.poses()),
-      surface_(std::make_shared<const RoadSurface>(Track::built_in(), seed)),
+      surface_(std::make_shared<const RoadSurface>(config.roads ? config.roads : built_in_roads(),
+                                                   seed)),
       road_(*surface_, config.road),
       spray_(seed, config_.spray) {
   state_.glass = config_.windshield.glass;
+  state_.roads = surface_->roads_shared();
   apply(initial);
   publish();
 }
@@ -144,6 +146,7 @@ SceneState Simulation::inputs_after(double dt_s) const {
   inputs.ego_lights = state_.ego_lights;
   inputs.traffic_lights = state_.traffic_lights;
   inputs.glass = state_.glass;
+  inputs.roads = state_.roads;
   // The road's water as the last step left it (it changes over seconds; the step may be running
   // while the road is drawn).
   inputs.road_water = state_.road_water;

@@ -31,7 +31,8 @@ struct AdvanceTiming {
 };
 
 struct SimulationConfig {
-  double sub_step_s = 1.0 / 240.0;  // fixed, so that lockstep runs reproduce
+  double sub_step_s = 1.0 / 240.0;           // fixed, so that lockstep runs reproduce
+  std::shared_ptr<const RoadNetwork> roads;  // null: the built-in track
   WindshieldConfig windshield;
   GlassWaterMapConfig water_map;
   RainFieldConfig rain;
@@ -67,6 +68,9 @@ struct SceneState {
   // in the order of `traffic`. Flashing lamps are lit at the frame's time (indicator_lit).
   VehicleLights ego_lights;
   std::vector<VehicleLights> traffic_lights;
+  // The roads the session drives on (road_network.hpp): the built-in track's unless the session
+  // brought its own.
+  std::shared_ptr<const RoadNetwork> roads;
 };
 
 class Simulation {

@@ -1,7 +1,11 @@
 // Requests the integration tests send: a view, an update of a car driving in rain.
 #pragma once
 
-#include "downpour/v1/downpour.pb.h"
+#include <string>
+
+#include <grpcpp/grpcpp.h>
+
+#include "downpour/v1/downpour.grpc.pb.h"
 
 namespace downpour::testing {
 
@@ -28,6 +32,15 @@ inline v1::Update drive_update(double t) {
   w->set_sun_altitude_deg(35.0);
   u.mutable_wipers()->set_mode(v1::WIPER_LOW);
   return u;
+}
+
+// Closes a session; whether the server said OK.
+inline bool close_session(v1::Downpour::Stub& stub, const std::string& id) {
+  grpc::ClientContext ctx;
+  v1::CloseSessionRequest req;
+  req.set_session_id(id);
+  v1::CloseSessionResponse resp;
+  return stub.CloseSession(&ctx, req, &resp).ok();
 }
 
 }  // namespace downpour::testing

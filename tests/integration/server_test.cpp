@@ -111,13 +111,7 @@ class ServerTest : public ::testing::Test {
     return info.session_id();
   }
 
-  void close(const std::string& id) {
-    grpc::ClientContext ctx;
-    v1::CloseSessionRequest req;
-    req.set_session_id(id);
-    v1::CloseSessionResponse resp;
-    EXPECT_TRUE(stub->CloseSession(&ctx, req, &resp).ok());
-  }
+  void close(const std::string& id) { EXPECT_TRUE(close_session(*stub, id)); }
 
   // A stub on its own connection with a small, fixed flow-control window (no BDP growth): a
   // reader that stops reading stops taking data after a few frames, like a stuck client.

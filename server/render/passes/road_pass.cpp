@@ -7,7 +7,7 @@
 
 #include "server/render/light_set.hpp"
 #include "server/render/relief.hpp"
-#include "server/render/scene_geometry.hpp"
+#include "server/render/world.hpp"
 
 namespace downpour::render {
 
@@ -34,15 +34,8 @@ RoadPass::RoadPass(SharedResources& shared)
                 ShaderProgram("road.vert", "road_relief.frag"),
                 ShaderProgram("road.vert", "road_mirror_relief.frag"),
                 ShaderProgram("road.vert", "road_ripples_relief.frag")},
-      chunks_(build_road_chunks(shared.track), {150.0f, 500.0f}),
       reliefs_(shared.reliefs) {
-  const sim::CrossSection& section = shared.track.cross_section();
-  for (const ShaderProgram& program : programs_) {
-    program.uniform("u_model").set(glm::mat4(1.0f));
-    program.uniform("u_lane_width").set(static_cast<float>(section.lane_width_m));
-    program.uniform("u_lanes_each_way").set(section.lanes_each_way);
-    program.uniform("u_paved_half_width").set(static_cast<float>(shared.track.paved_half_width()));
-  }
+  for (const ShaderProgram& program : programs_) program.uniform("u_model").set(glm::mat4(1.0f));
   for (std::size_t p = 0; p < programs_.size(); ++p) {
     mean_lit_[p] = programs_[p].uniform("u_relief_mean_lit");
     near_split_[p] = programs_[p].uniform("u_near_split");
@@ -104,12 +97,12 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
     programs_[plain + 3].use();
     mean_lit_[plain + 3].set(mean_lit);
     near_split_[plain + 3].set(glm::vec2(reach, 1.0f));
-    chunks_.draw_visible(view_proj, frame.camera.position);
+    frame.world->road.draw_visible(view_proj, frame.camera.position);
   }
   programs_[plain].use();
   mean_lit_[plain].set(mean_lit);
   near_split_[plain].set(glm::vec2(drew_relief_ ? reach : 0.0f, -1.0f));
-  chunks_.draw_visible(view_proj, frame.camera.position);
+  frame.world->road.draw_visible(view_proj, frame.camera.position);
   glDisable(GL_CLIP_DISTANCE1);
 }
 

@@ -38,7 +38,6 @@ class RoadPass final : public Pass {
   // Each program's per-frame uniforms, looked up once.
   std::array<Uniform, 6> mean_lit_;
   std::array<Uniform, 6> near_split_;
-  ChunkedMesh chunks_;
   std::shared_ptr<const relief::RoadReliefs> reliefs_;
   bool relief_ = true;
   bool drew_relief_ = false;

@@ -5,12 +5,13 @@
 
 namespace downpour::render {
 
-// The track's street lights (sim/lights.hpp): a pole on the verge, an arm over the road and a
-// lamp at its end, whose lens glows when the lights are on (their light on the ground is the lamp
-// map's). Static geometry in chunks of four poles, culled against the view and beyond
-// kStreetLightsDrawnWithin_m (a pole there is a fifth of a pixel wide at 640 x 360; at night the
-// lamp_glow pass still draws its lens) times the frame's detail distance scale (the road's mirror,
-// at a quarter of the size, stops at a quarter of it); mirrored in the wet road with the cars.
+// The roads' street lights (sim/lights.hpp; their meshes in world.hpp): a pole on the verge, an arm
+// over the road and a lamp at its end, whose lens glows when the lights are on (their light on the
+// ground is the lamp map's). Static geometry in chunks of four poles, culled against the view and
+// beyond kStreetLightsDrawnWithin_m (a pole there is a fifth of a pixel wide at 640 x 360; at night
+// the lamp_glow pass still draws its lens) times the frame's detail distance scale (the road's
+// mirror, at a quarter of the size, stops at a quarter of it); mirrored in the wet road with the
+// cars.
 inline constexpr float kStreetLightsDrawnWithin_m = 350.0f;
 class StreetLightPass final : public Pass {
  public:
@@ -25,7 +26,6 @@ class StreetLightPass final : public Pass {
                        {DepthTest::kNearer, true, Blend::kOff}};
   ShaderProgram program_;
   Uniform u_head_;
-  ChunkedMesh chunks_;
 };
 
 // The street lights' meshes, four poles a chunk (one level of detail).

@@ -1,6 +1,5 @@
 #pragma once
 
-#include "server/render/chunked_mesh.hpp"
 #include "server/render/pass.hpp"
 
 namespace downpour::render {
@@ -19,7 +18,6 @@ class TerrainPass final : public Pass {
                        {Resource::kViewColour, Resource::kViewDepth},
                        {DepthTest::kNearer, true, Blend::kOff}};
   ShaderProgram program_;
-  ChunkedMesh chunks_;
 };
 
 }  // namespace downpour::render

@@ -23,7 +23,7 @@ TEST_F(RoadSurfaceTest, ReliefIsBelowTheSectionOnThePavedWidthAndNoneOffIt) {
   for (double s = 0.0; s < track.length(); s += 0.7) {
     for (double lateral = -half - 3.0; lateral <= half + 3.0; lateral += 0.13) {
       const double r = surface.relief(s, lateral);
-      if (!surface.paved(lateral)) {
+      if (!surface.paved({0, s, lateral})) {
         ASSERT_EQ(r, 0.0) << s << " " << lateral;
         continue;
       }
