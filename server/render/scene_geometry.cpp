@@ -64,7 +64,10 @@ void road_piece(const sim::RoadNetwork& roads, int road, double s0, double s1,
     int per_row = 0;
     for (const double s : rows) {
       const sim::TrackFrame f = roads.frame(road, s);
-      const sim::LaneLayout layout = roads.lanes(road, s);
+      sim::LaneLayout layout = roads.lanes(road, s);
+      // No lines across a junction: its connecting roads overlap, and their marks (which SUMO's
+      // netconvert, for one, writes) would draw a tangle of curves over it.
+      if (roads.connecting(road)) layout.marks.assign(layout.marks.size(), sim::LaneMark{});
       const sim::PavedSpan span{layout.right(), layout.left()};
       const glm::dvec3 forward(std::cos(f.heading_rad), std::sin(f.heading_rad), f.grade);
       const std::size_t first = m.vertices.size();

@@ -61,6 +61,13 @@ void fill_frame(const session::EncodedFrame& f, std::uint64_t reader_drops, v1::
     tire->set_standing_mm(t.standing_mm);
     tire->set_state(to_proto(t.state));
   }
+  v1::RoadPlace* place = out->mutable_ego_place();
+  place->set_road_id(f.ego_place.road);
+  place->set_s_m(f.ego_place.s_m);
+  place->set_t_m(f.ego_place.t_m);
+  place->set_lane_id(f.ego_place.lane);
+  place->set_lane_offset_m(f.ego_place.lane_offset_m);
+  place->set_on_road(f.ego_place.on_road);
 }
 
 void fill_session_info(const session::Session& session, v1::SessionInfo* out) {

@@ -36,6 +36,7 @@ struct EncodedFrame {
   std::string jpeg;
   FrameStats stats;
   std::array<sim::TireWater, sim::kTires> tires{};  // the tick's: the road's water under the tires
+  sim::EgoPlace ego_place;                          // the tick's
 };
 
 using FramePtr = std::shared_ptr<const EncodedFrame>;

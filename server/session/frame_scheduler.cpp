@@ -73,6 +73,7 @@ struct FrameScheduler::InFlight {
   std::uint32_t rain_streaks = 0;
   double visibility_m = 0.0;
   std::array<sim::TireWater, sim::kTires> tires{};
+  sim::EgoPlace ego_place;
   Clock::time_point inputs_arrived;
 };
 
@@ -441,6 +442,7 @@ void FrameScheduler::tick(const std::shared_ptr<Session>& s, const StartedStep& 
     const render::RoadStateFractions road = render::view_road_states(views[f.view_index], scene);
     f.road_states = {road.dry, road.wet, road.drench, road.puddle};
     f.tires = scene.tires;
+    f.ego_place = scene.ego_place;
     readbacks_->push(readback, std::move(f));
   }
 }
@@ -495,6 +497,7 @@ void FrameScheduler::encode(InFlight f, std::vector<std::uint8_t> pixels, double
     frame->stats.rain_streaks = f.rain_streaks;
     frame->stats.visibility_m = f.visibility_m;
     frame->tires = f.tires;
+    frame->ego_place = f.ego_place;
     ++frames_encoded_;
     {
       std::lock_guard lock(stats_mutex_);

@@ -19,6 +19,7 @@ class OpenDriveRoads final : public RoadNetwork {
   const road::Network& network() const { return network_; }
 
   int road_count() const override { return static_cast<int>(network_.roads.size()); }
+  std::string road_id(int road) const override { return network_.roads[road].id; }
   double road_length(int road) const override { return network_.roads[road].length; }
   bool road_loops(int) const override { return false; }
   bool connecting(int road) const override { return network_.roads[road].junction != "-1"; }

@@ -60,6 +60,24 @@ TrackRoads::TrackRoads(const Track& track) : track_(track) {
   }
 }
 
+EgoPlace ego_place(const RoadNetwork& roads, glm::dvec2 xy) {
+  const RoadPlace p = roads.project(xy, 30.0);
+  EgoPlace out;
+  out.road = roads.road_id(p.road);
+  out.s_m = p.s;
+  out.t_m = p.t;
+  const LaneLayout layout = roads.lanes(p.road, p.s);
+  out.on_road = roads.paved(p.road, p.s).contains(p.t);
+  if (layout.borders.size() < 2) return out;
+  // The lane holding t (beyond the edges, the outermost).
+  std::size_t i = 0;
+  while (i + 2 < layout.borders.size() && p.t > layout.borders[i + 1]) ++i;
+  const auto index = static_cast<int>(i);
+  out.lane = index >= layout.centre ? index - layout.centre + 1 : index - layout.centre;
+  out.lane_offset_m = p.t - 0.5 * (layout.borders[i] + layout.borders[i + 1]);
+  return out;
+}
+
 const std::shared_ptr<const RoadNetwork>& built_in_roads() {
   static const std::shared_ptr<const RoadNetwork> roads =
       std::make_shared<const TrackRoads>(Track::built_in());

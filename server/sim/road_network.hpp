@@ -7,11 +7,13 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <glm/vec2.hpp>
 
 #include "server/sim/track.hpp"
+#include "server/sim/types.hpp"
 
 namespace downpour::sim {
 
@@ -62,6 +64,7 @@ class RoadNetwork {
   virtual ~RoadNetwork() = default;
 
   virtual int road_count() const = 0;
+  virtual std::string road_id(int road) const = 0;
   virtual double road_length(int road) const = 0;
   // Whether s wraps around (the built-in track's loop).
   virtual bool road_loops(int road) const = 0;
@@ -101,6 +104,7 @@ class TrackRoads final : public RoadNetwork {
   const Track& track() const { return track_; }
 
   int road_count() const override { return 1; }
+  std::string road_id(int) const override { return "track"; }
   double road_length(int) const override { return track_.length(); }
   bool road_loops(int) const override { return true; }
   bool connecting(int) const override { return false; }
@@ -122,6 +126,9 @@ class TrackRoads final : public RoadNetwork {
   const Track& track_;
   glm::dvec2 lo_{0.0}, hi_{0.0};
 };
+
+// The place of a horizontal position on the roads, with its lane (EgoPlace, types.hpp).
+EgoPlace ego_place(const RoadNetwork& roads, glm::dvec2 xy);
 
 // The built-in track's network, made once.
 const std::shared_ptr<const RoadNetwork>& built_in_roads();

@@ -71,6 +71,7 @@ void Simulation::publish() {
     const double water = road_.water_m(xy);
     state_.tires[t] = {water * 1e3, road_.standing_m(xy) * 1e3, road_.state_of(water)};
   }
+  state_.ego_place = ego_place(surface_->roads(), glm::dvec2(state_.vehicle.position_m));
 }
 
 void Simulation::apply(const Update& update) {

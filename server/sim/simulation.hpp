@@ -58,6 +58,7 @@ struct SceneState {
   WindshieldState windshield;             // published once per advance(), not per sub-step
   RainState rain;                         // likewise
   std::array<TireWater, kTires> tires{};  // the road's water under the ego car's tires, likewise
+  EgoPlace ego_place;                     // likewise
   // The road's water around the car, for drawing; shared by copies, replaced after each road
   // step (null before the first).
   std::shared_ptr<const RoadWaterImage> road_water;

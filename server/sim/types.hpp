@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -84,6 +85,17 @@ struct TireWater {
   RoadState state = RoadState::kDry;
 };
 inline constexpr int kTires = 4;  // front left, front right, rear left, rear right
+
+// Where the ego car is on the session's roads after a step (its pose's reference point): for a
+// simulator to check that its roads and the server's agree.
+struct EgoPlace {
+  std::string road;  // the road's id (the built-in track's: "track")
+  double s_m = 0.0;
+  double t_m = 0.0;  // left positive, from the road's reference line
+  int lane = 0;      // OpenDRIVE's lane id: 1, 2, ... left of the centre lane, -1, -2, ... right
+  double lane_offset_m = 0.0;  // from the lane's centre line, left positive
+  bool on_road = false;        // on the paved width
+};
 
 // A partial update: what is present is applied, what is absent keeps its value.
 struct Update {

@@ -116,12 +116,18 @@ class DownpourClient:
     def __exit__(self, *exc_info):
         self.close()
 
-    def create_session(self, views, mode="LOCKSTEP", fps=0.0, seed=0, initial=None):
-        """Views as ViewSpecs, (view, width, height[, quality]) tuples or dicts -> SessionInfo."""
+    def create_session(self, views, mode="LOCKSTEP", fps=0.0, seed=0, initial=None, roads=None):
+        """Views as ViewSpecs, (view, width, height[, quality]) tuples or dicts -> SessionInfo.
+        roads: a RoadNetwork, {"map_name": ...} or {"opendrive_xml": ...}; None, the built-in
+        track."""
         request = pb.CreateSessionRequest(
             views=[to_view_spec(v) for v in views], mode=mode_value(mode), fps=fps, seed=seed)
         if initial is not None:
             request.initial.CopyFrom(initial)
+        if isinstance(roads, dict):
+            roads = pb.RoadNetwork(**roads)
+        if roads is not None:
+            request.roads.CopyFrom(roads)
         return self.create_session_from(request)
 
     def create_session_from(self, request):

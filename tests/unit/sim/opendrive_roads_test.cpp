@@ -133,6 +133,32 @@ TEST_F(OpenDriveRoadsTest, FramesAndLanesAreTheFilesOwn) {
   EXPECT_NEAR(roads->surface_height({0, 10.0, 9.0}), roads->surface_height({0, 10.0, 3.5}), 1e-12);
 }
 
+TEST_F(OpenDriveRoadsTest, AnEgoPlaceNamesItsRoadAndLane) {
+  const EgoPlace inner = ego_place(*roads, {30.0, -1.75});
+  EXPECT_EQ(inner.road, "1");
+  EXPECT_NEAR(inner.s_m, 30.0, 1e-6);
+  EXPECT_EQ(inner.lane, -1);
+  EXPECT_NEAR(inner.lane_offset_m, 0.0, 1e-6);
+  EXPECT_TRUE(inner.on_road);
+  const EgoPlace left = ego_place(*roads, {30.0, 2.0});
+  EXPECT_EQ(left.lane, 1);
+  EXPECT_NEAR(left.lane_offset_m, 0.25, 1e-6);
+  const EgoPlace shoulder = ego_place(*roads, {30.0, -4.5});
+  EXPECT_EQ(shoulder.lane, -2);
+  EXPECT_NEAR(shoulder.lane_offset_m, -0.25, 1e-6);
+  const EgoPlace off = ego_place(*roads, {30.0, -9.0});
+  EXPECT_FALSE(off.on_road);
+  EXPECT_EQ(off.lane, -2) << "beyond the edge: the outermost lane";
+  // The built-in track: lane -2 is its outer lane, driving forwards.
+  const Track& track = Track::built_in();
+  const TrackFrame f = track.at(500.0);
+  const EgoPlace on_track =
+      ego_place(*built_in_roads(), glm::dvec2(f.position) + f.left * track.lane_centre(1));
+  EXPECT_EQ(on_track.road, "track");
+  EXPECT_EQ(on_track.lane, -2);
+  EXPECT_NEAR(on_track.lane_offset_m, 0.0, 0.01);
+}
+
 TEST_F(OpenDriveRoadsTest, TheReliefLiesInTheDrivenLanesWheelPathsAndRepeatsWithTheSeed) {
   const RoadSurface surface(roads, 11);
   const RoadSurface again(roads, 11);
