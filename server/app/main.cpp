@@ -105,7 +105,9 @@ int main(int argc, char** argv) {
   limits.max_width = config->max_width;
   limits.max_height = config->max_height;
   limits.max_fps = config->max_fps;
-  auto road_networks = std::make_shared<rpc::RoadNetworks>(config->maps_dir);
+  road::Limits road_limits;
+  road_limits.max_total_length_m = config->max_road_km * 1000.0;
+  auto road_networks = std::make_shared<rpc::RoadNetworks>(config->maps_dir, road_limits);
   if (!config->maps_dir.empty()) spdlog::info("maps from {}", config->maps_dir);
   rpc::DownpourService service(registry, scheduler, limits, auth, road_networks);
 

@@ -180,6 +180,10 @@ std::optional<ServerConfig> parse_config(int argc, char** argv, int* exit_code) 
                  "beyond 64)")
       ->check(CLI::Range(1, 64))
       ->envname("DOWNPOUR_MAX_MESSAGE_MB");
+  app.add_option("--max-road-km", c.max_road_km,
+                 "the most road a session's network may have, km (every road's length added)")
+      ->check(CLI::Range(0.1, 1000.0))
+      ->envname("DOWNPOUR_MAX_ROAD_KM");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

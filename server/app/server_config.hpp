@@ -53,6 +53,10 @@ struct ServerConfig {
   // directory (empty: none); and the largest request (inline OpenDRIVE text counts), MiB.
   std::string maps_dir;
   int max_message_mb = 1;
+  // A session's road network: the most road (km, every road's length added), which bounds the
+  // time and memory its scene takes to build (on the CreateSession call's thread, not the render
+  // loop's: about 40 ms and 3 MiB a km of six-lane road here).
+  double max_road_km = 50.0;
 };
 
 // Parses argv; on --help or an error returns the exit code to use instead of a config.

@@ -2,22 +2,65 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
+#include <mutex>
+
+#include <spdlog/spdlog.h>
 
 #include "server/render/passes/street_light_pass.hpp"
 #include "server/render/scene_geometry.hpp"
 
 namespace downpour::render {
 
-World make_world(const sim::RoadNetwork& roads) {
+namespace {
+
+// Geometry prepared ahead of its first frame, by network, until the render thread takes it.
+struct Prepared {
+  std::mutex mutex;
+  std::map<const sim::RoadNetwork*,
+           std::pair<std::weak_ptr<const sim::RoadNetwork>, std::shared_ptr<const WorldGeometry>>>
+      worlds;
+  void drop_expired() {
+    std::erase_if(worlds, [](const auto& e) { return e.second.first.expired(); });
+  }
+};
+Prepared& prepared() {
+  static Prepared p;
+  return p;
+}
+
+}  // namespace
+
+WorldGeometry build_world_geometry(const sim::RoadNetwork& roads) {
   const auto t0 = std::chrono::steady_clock::now();
-  World w;
-  w.street_lights = sim::street_lights(roads);
-  w.road = ChunkedMesh(build_road_chunks(roads), {150.0f, 500.0f});
-  w.terrain = ChunkedMesh(build_terrain_chunks(roads), {200.0f, 500.0f, 1200.0f});
-  w.street_light_poles =
-      ChunkedMesh(build_street_light_chunks(w.street_lights), {}, kStreetLightsDrawnWithin_m);
-  w.build_ms =
+  WorldGeometry g;
+  g.street_lights = sim::street_lights(roads);
+  g.road = build_road_chunks(roads);
+  g.terrain = build_terrain_chunks(roads);
+  g.poles = build_street_light_chunks(g.street_lights);
+  g.build_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return g;
+}
+
+void prepare_world(const std::shared_ptr<const sim::RoadNetwork>& roads) {
+  if (!roads) return;
+  {
+    std::lock_guard lock(prepared().mutex);
+    prepared().drop_expired();
+    if (prepared().worlds.count(roads.get())) return;
+  }
+  auto geometry = std::make_shared<const WorldGeometry>(build_world_geometry(*roads));
+  std::lock_guard lock(prepared().mutex);
+  prepared().worlds.emplace(roads.get(), std::make_pair(roads, std::move(geometry)));
+}
+
+World make_world(const WorldGeometry& g) {
+  World w;
+  w.street_lights = g.street_lights;
+  w.road = ChunkedMesh(g.road, {150.0f, 500.0f});
+  w.terrain = ChunkedMesh(g.terrain, {200.0f, 500.0f, 1200.0f});
+  w.street_light_poles = ChunkedMesh(g.poles, {}, kStreetLightsDrawnWithin_m);
   return w;
 }
 
@@ -28,8 +71,26 @@ const World& Worlds::get(const std::shared_ptr<const sim::RoadNetwork>& given) {
   for (const Entry& e : entries_) {
     if (e.key == roads.get()) return *e.world;
   }
+  // Prepared where the network was loaded, or built here (hand-made scenes, the built-in track).
+  std::shared_ptr<const WorldGeometry> geometry;
+  {
+    std::lock_guard lock(prepared().mutex);
+    prepared().drop_expired();
+    if (const auto it = prepared().worlds.find(roads.get()); it != prepared().worlds.end()) {
+      geometry = std::move(it->second.second);
+      prepared().worlds.erase(it);
+    }
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const bool built_here = !geometry;
+  if (built_here) geometry = std::make_shared<const WorldGeometry>(build_world_geometry(*roads));
   // (The world holds no reference to the network, so that it can go with its last session.)
-  auto world = std::make_unique<World>(make_world(*roads));
+  auto world = std::make_unique<World>(make_world(*geometry));
+  spdlog::debug(
+      "road network of {} roads drawn: geometry {:.0f} ms ({}), upload {:.0f} ms",
+      roads->road_count(), geometry->build_ms, built_here ? "here" : "prepared",
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() -
+          (built_here ? geometry->build_ms : 0.0));
   entries_.push_back({roads, roads.get(), std::move(world)});
   return *entries_.back().world;
 }

@@ -9,6 +9,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "server/render/world.hpp"
 #include "server/rpc/convert.hpp"
 #include "server/session/latest_frame_slot.hpp"
 
@@ -515,6 +516,9 @@ grpc::ServerUnaryReactor* DownpourService::CreateSession(grpc::CallbackServerCon
   LoadedRoads roads;
   if (auto s = context_.road_networks->load(request->roads(), "roads", &roads); !s.ok())
     return finish(ctx, s);
+  // The scene of a new network is built here, on this call's thread, not in the render loop that
+  // every session shares (it only uploads it).
+  render::prepare_world(roads.roads);
   config.roads = std::move(roads.roads);
   config.road_network = std::move(roads.name);
   std::string refusal;

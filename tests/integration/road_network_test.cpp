@@ -77,8 +77,8 @@ Ground ground_of(const std::string& jpeg) {
 class RoadNetworkTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    server = new ServerProcess(
-        {"--maps-dir", DOWNPOUR_TEST_MAPS_DIR, "--max-message-mb", "2", "--max-sessions", "4"});
+    server = new ServerProcess({"--maps-dir", DOWNPOUR_TEST_MAPS_DIR, "--max-message-mb", "2",
+                                "--max-sessions", "4", "--max-road-km", "5"});
   }
   static void TearDownTestSuite() {
     EXPECT_EQ(server->stop(15.0), 0);
@@ -186,6 +186,17 @@ TEST_F(RoadNetworkTest, InlineOpenDriveIsParsedAndBadInputIsRefusedClearly) {
     refused(map(name), grpc::StatusCode::INVALID_ARGUMENT, "roads.map_name");
   }
   refused(map("atlantis"), grpc::StatusCode::NOT_FOUND, "no map \"atlantis\"");
+  // More road than the server builds a scene for (5 km here).
+  std::string long_roads = "<OpenDRIVE><header revMajor=\"1\" revMinor=\"6\"/>";
+  for (const char* id : {"a", "b"}) {
+    long_roads += std::string("<road id=\"") + id + R"(" length="3000" junction="-1">
+      <planView><geometry s="0" x="0" y="0" hdg="0" length="3000"><line/></geometry></planView>
+      <lanes><laneSection s="0"><center><lane id="0" type="none"/></center></laneSection></lanes>
+    </road>)";
+  }
+  v1::RoadNetwork too_long;
+  too_long.set_opendrive_xml(long_roads + "</OpenDRIVE>");
+  refused(too_long, grpc::StatusCode::INVALID_ARGUMENT, "add up to more than 5000");
   // Past the message limit (2 MiB here): gRPC's own refusal.
   v1::RoadNetwork huge;
   huge.set_opendrive_xml(std::string(3 << 20, ' '));
