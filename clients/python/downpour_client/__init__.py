@@ -24,11 +24,12 @@ def _add_stubs_to_path():
 _add_stubs_to_path()
 
 from .client import DownpourClient, add_security_arguments, security_options  # noqa: E402
+from .frames import write_frames  # noqa: E402
 from .messages import (  # noqa: E402
     enum_name, mode_value, view_spec, view_value, wiper_mode_value)
 from .scenario import Scenario  # noqa: E402
 
 __all__ = [
     "DownpourClient", "Scenario", "add_security_arguments", "enum_name", "mode_value",
-    "security_options", "view_spec", "view_value", "wiper_mode_value",
+    "security_options", "view_spec", "view_value", "wiper_mode_value", "write_frames",
 ]

@@ -9,10 +9,10 @@ from the other with netconvert); --xodr FILE sends them inline instead. Frames a
 """
 
 import argparse
-import os
 import sys
 
-from downpour_client import DownpourClient, Scenario, add_security_arguments, security_options
+from downpour_client import (DownpourClient, Scenario, add_security_arguments, security_options,
+                             write_frames)
 from downpour.v1 import downpour_pb2 as pb
 
 from .bridge import SumoBridge, run_lockstep, run_realtime, scenario_conditions
@@ -65,15 +65,9 @@ def main(argv=None):
             if args.realtime:
                 run_realtime(client, info.session_id, bridge, args.seconds, conditions)
             else:
-                if args.out:
-                    os.makedirs(args.out, exist_ok=True)
-
                 def save(update, frames):
-                    for f in frames:
-                        if args.out:
-                            name = f"{f.frame_number:05d}_{pb.View.Name(f.view)}.jpg"
-                            with open(os.path.join(args.out, name), "wb") as file:
-                                file.write(f.jpeg)
+                    if args.out:
+                        write_frames(args.out, frames)
                     place = frames[0].ego_place
                     print(f"t {update.sim_time_s:6.2f} s  road {place.road_id} lane "
                           f"{place.lane_id} offset {place.lane_offset_m:+.2f} m")
