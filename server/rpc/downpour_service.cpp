@@ -245,6 +245,7 @@ class DriveReactor final : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc
         std::lock_guard lock(mutex_);
         session_ = session;
         lockstep_ = session->config().mode == sim::Mode::kLockstep;
+        views_ = session->config().views.size();
       }
       session->attach_stream();  // detached in OnDone
       // A sink in both modes: it hears when the session ends (a lockstep stream takes its frames
@@ -310,9 +311,10 @@ class DriveReactor final : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc
           ++first_index_;
           start_write = true;
         }
-      } else if (FramePtr frame = slot_.take()) {
+      } else if (std::vector<FramePtr> tick = slot_.take_tick(views_); !tick.empty()) {
+        // A tick's views together in one response, as lockstep sends them.
         out_.Clear();
-        fill_frame(*frame, slot_.drops(), out_.add_frames());
+        for (const FramePtr& frame : tick) fill_frame(*frame, slot_.drops(), out_.add_frames());
         start_write = true;
       }
       writing_ = start_write;
@@ -367,6 +369,7 @@ class DriveReactor final : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc
   std::mutex mutex_;
   std::shared_ptr<Session> session_;  // guarded by mutex_
   bool lockstep_ = false;             // set with session_
+  std::size_t views_ = 1;             // likewise: the session's views, a tick's frames
   std::deque<std::optional<v1::DriveResponse>>
       pending_;                               // guarded by mutex_: lockstep responses in order
   std::size_t first_index_ = 0;               // guarded by mutex_: index of pending_.front()

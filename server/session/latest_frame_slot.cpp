@@ -27,6 +27,29 @@ FramePtr LatestFrameSlot::take() {
   return out;
 }
 
+std::vector<FramePtr> LatestFrameSlot::take_tick(std::size_t views) {
+  std::lock_guard lock(mutex_);
+  std::vector<FramePtr> out;
+  const FramePtr* oldest = nullptr;
+  bool later = false;
+  for (const FramePtr& p : pending_) {
+    if (p && (!oldest || p->frame_number < (*oldest)->frame_number)) oldest = &p;
+  }
+  if (!oldest) return out;
+  const std::uint64_t tick = (*oldest)->frame_number;
+  std::size_t count = 0;
+  for (const FramePtr& p : pending_) {
+    if (!p) continue;
+    count += p->frame_number == tick;
+    later = later || p->frame_number > tick;
+  }
+  if (count < views && !later) return out;  // the tick's other views are still on their way
+  for (FramePtr& p : pending_) {
+    if (p && p->frame_number == tick) out.push_back(std::move(p)), p.reset();
+  }
+  return out;
+}
+
 std::uint64_t LatestFrameSlot::drops() const {
   std::lock_guard lock(mutex_);
   return drops_;

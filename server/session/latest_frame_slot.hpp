@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <mutex>
+#include <vector>
 
 #include "server/session/frame.hpp"
 
@@ -19,6 +20,9 @@ class LatestFrameSlot {
   PutResult put(FramePtr frame);
   // The oldest pending frame (lowest frame number) across views, or null; clears its place.
   FramePtr take();
+  // The oldest tick's frames, in view order, once the tick is whole (`views` of them) or can no
+  // longer be (a view has a later frame pending: the tick's was taken or replaced); else none.
+  std::vector<FramePtr> take_tick(std::size_t views);
   std::uint64_t drops() const;
 
  private:

@@ -374,6 +374,34 @@ class ServerTest(ServerProcessCase):
         self.assertGreaterEqual(len(numbers), 5, numbers)
         self.assertEqual(numbers, sorted(set(numbers)))
 
+    def test_realtime_drive_sends_a_ticks_views_together(self):
+        session_id = self.open_session(views=VIEWS, mode=pb.MODE_REALTIME, fps=20)
+        stop = threading.Event()
+
+        def requests():
+            yield pb.DriveRequest(session_id=session_id, update=inputs(0))
+            stop.wait(10.0)
+
+        call = self.client.drive(requests())
+        timer = threading.Timer(2.0, call.cancel)
+        timer.start()
+        ticks = []
+        try:
+            for response in call:
+                ticks.append([(f.frame_number, f.view) for f in response.frames])
+        except grpc.RpcError as error:
+            self.assertEqual(error.code(), grpc.StatusCode.CANCELLED)
+        finally:
+            timer.cancel()
+            stop.set()
+        self.assertGreaterEqual(len(ticks), 5, ticks)
+        for tick in ticks:
+            self.assertEqual(sorted(view for _, view in tick), [pb.VIEW_COCKPIT, pb.VIEW_ROAD],
+                             tick)
+            self.assertEqual(len({number for number, _ in tick}), 1, tick)
+        numbers = [tick[0][0] for tick in ticks]
+        self.assertEqual(numbers, sorted(set(numbers)))
+
     def assert_status(self, code, field, call, *args, **kwargs):
         with self.assertRaises(grpc.RpcError) as caught:
             call(*args, **kwargs)

@@ -36,6 +36,32 @@ TEST(LatestFrameSlotTest, TakesLowestFrameNumberFirstAcrossViews) {
   EXPECT_EQ(slot.take(), nullptr);
 }
 
+TEST(LatestFrameSlotTest, ATicksViewsAreTakenTogetherOnceAllHaveCome) {
+  LatestFrameSlot slot;
+  slot.put(make_frame(4, sim::View::kRoad));
+  EXPECT_TRUE(slot.take_tick(2).empty()) << "the tick's COCKPIT frame is still on its way";
+  slot.put(make_frame(4, sim::View::kCockpit));
+  const std::vector<FramePtr> tick = slot.take_tick(2);
+  ASSERT_EQ(tick.size(), 2u);
+  EXPECT_EQ(tick[0]->frame_number, 4u);
+  EXPECT_EQ(tick[1]->frame_number, 4u);
+  EXPECT_NE(tick[0]->view, tick[1]->view);
+  EXPECT_TRUE(slot.take_tick(2).empty());
+  // A reader that fell behind: ROAD's frame 5 was replaced by 6, so tick 5 can never be whole;
+  // its COCKPIT frame goes alone, then tick 6 once whole.
+  slot.put(make_frame(5, sim::View::kCockpit));
+  slot.put(make_frame(5, sim::View::kRoad));
+  slot.put(make_frame(6, sim::View::kRoad));
+  const std::vector<FramePtr> partial = slot.take_tick(2);
+  ASSERT_EQ(partial.size(), 1u);
+  EXPECT_EQ(partial[0]->frame_number, 5u);
+  EXPECT_EQ(partial[0]->view, sim::View::kCockpit);
+  EXPECT_TRUE(slot.take_tick(2).empty());
+  slot.put(make_frame(6, sim::View::kCockpit));
+  EXPECT_EQ(slot.take_tick(2).size(), 2u);
+  EXPECT_EQ(slot.drops(), 1u);
+}
+
 TEST(LatestFrameSlotTest, WasEmptyAgainAfterEverythingIsTaken) {
   LatestFrameSlot slot;
   EXPECT_TRUE(slot.put(make_frame(1, sim::View::kCockpit)).was_empty);
