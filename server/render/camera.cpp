@@ -18,12 +18,12 @@ constexpr double kCameraApertureMm = 2.0;
 
 }  // namespace
 
-sim::CameraPose default_camera_pose(sim::View view) {
+sim::CameraPose default_camera_pose(sim::View view, const glm::dvec3& eye_m) {
   switch (view) {
     case sim::View::kRoad:
       return {{-6.5, 0.0, 2.6}, {0.0, 11.0, 0.0}};
     default:
-      return {kDriverEye, {0.0, 2.0, 0.0}};
+      return {eye_m, {0.0, 2.0, 0.0}};
   }
 }
 
@@ -32,7 +32,8 @@ double default_fov_deg(sim::View view) { return view == sim::View::kRoad ? 55.0 
 sim::CameraPose dash_camera_pose() { return {{1.52, 0.0, 1.21}, {0.0, 3.0, 0.0}}; }
 
 Camera make_camera(const sim::ViewSpec& spec, const sim::VehicleState& vehicle) {
-  const sim::CameraPose pose = spec.camera ? *spec.camera : default_camera_pose(spec.view);
+  const sim::CameraPose pose =
+      spec.camera ? *spec.camera : default_camera_pose(spec.view, spec.eye_m);
   // Camera frame in the vehicle frame, then GL's camera axes (x right, y up, looking down -z).
   glm::dmat4 cam_in_vehicle(sim::rotation_matrix(pose.rotation));
   cam_in_vehicle[3] = glm::dvec4(pose.position_m, 1.0);

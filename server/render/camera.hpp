@@ -27,7 +27,8 @@ struct Camera {
 };
 
 // Default poses and fields of view, vehicle frame.
-sim::CameraPose default_camera_pose(sim::View view);
+sim::CameraPose default_camera_pose(sim::View view,
+                                    const glm::dvec3& eye_m = sim::EgoGeometry{}.eye_m);
 double default_fov_deg(sim::View view);
 // A forward (dash) camera for the COCKPIT view: on the centre line just behind the glass, in front
 // of the mirror, looking ahead a little down.

@@ -271,6 +271,35 @@ grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, cons
   return grpc::Status::OK;
 }
 
+grpc::Status to_ego(const v1::EgoVehicle& in, const std::string& field, sim::EgoGeometry* out) {
+  sim::EgoGeometry ego;
+  auto given = [](const v1::Vec3& v) { return v.x() != 0.0 || v.y() != 0.0 || v.z() != 0.0; };
+  if (given(in.size_m())) {
+    DP_RETURN_IF_ERROR(in_range(in.size_m().x(), 2.0, 20.0, field + ".size_m.x"));
+    DP_RETURN_IF_ERROR(in_range(in.size_m().y(), 1.0, 3.5, field + ".size_m.y"));
+    DP_RETURN_IF_ERROR(in_range(in.size_m().z(), 1.0, 5.0, field + ".size_m.z"));
+    ego.size_m = {in.size_m().x(), in.size_m().y(), in.size_m().z()};
+  }
+  if (in.wheelbase_m() != 0.0 || !std::isfinite(in.wheelbase_m())) {
+    DP_RETURN_IF_ERROR(in_range(in.wheelbase_m(), 1.0, 0.9 * ego.size_m.x, field + ".wheelbase_m"));
+    ego.wheelbase_m = in.wheelbase_m();
+  }
+  if (in.track_m() != 0.0 || !std::isfinite(in.track_m())) {
+    DP_RETURN_IF_ERROR(in_range(in.track_m(), 0.8, ego.size_m.y, field + ".track_m"));
+    ego.track_m = in.track_m();
+  }
+  if (given(in.eye_m())) {
+    // Within the cabin (the default car's, whatever the size): behind the windshield, under the
+    // roof.
+    DP_RETURN_IF_ERROR(in_range(in.eye_m().x(), 0.6, 1.6, field + ".eye_m.x"));
+    DP_RETURN_IF_ERROR(in_range(in.eye_m().y(), -0.6, 0.6, field + ".eye_m.y"));
+    DP_RETURN_IF_ERROR(in_range(in.eye_m().z(), 0.9, 1.35, field + ".eye_m.z"));
+    ego.eye_m = {in.eye_m().x(), in.eye_m().y(), in.eye_m().z()};
+  }
+  *out = ego;
+  return grpc::Status::OK;
+}
+
 grpc::Status to_session_config(const v1::CreateSessionRequest& in, const Limits& limits,
                                session::SessionConfig* config, sim::Update* initial) {
   if (in.views_size() == 0) return invalid("views", "at least one view is needed");
@@ -304,6 +333,8 @@ grpc::Status to_session_config(const v1::CreateSessionRequest& in, const Limits&
     DP_RETURN_IF_ERROR(in_range(in.fps(), 0.1, limits.max_fps, "fps"));
   c.fps = in.fps() > 0.0 ? in.fps() : 30.0;
   c.seed = in.seed();
+  DP_RETURN_IF_ERROR(to_ego(in.ego(), "ego", &c.ego));
+  for (sim::ViewSpec& spec : c.views) spec.eye_m = c.ego.eye_m;
   DP_RETURN_IF_ERROR(to_update(in.initial(), "initial", limits, initial));
   *config = std::move(c);
   return grpc::Status::OK;

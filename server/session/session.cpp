@@ -9,6 +9,7 @@ namespace {
 sim::SimulationConfig simulation_config(const SessionConfig& config) {
   sim::SimulationConfig c;
   c.roads = config.roads;
+  c.ego = config.ego;
   return c;
 }
 

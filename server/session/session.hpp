@@ -29,6 +29,7 @@ struct SessionConfig {
   // Its roads (sim/road_network.hpp): null, the built-in track; and what the client named them.
   std::shared_ptr<const sim::RoadNetwork> roads;
   std::string road_network = "built-in track";
+  sim::EgoGeometry ego;
 };
 
 struct StepOutcome {

@@ -40,6 +40,7 @@ Simulation::Simulation(std::uint64_t seed, const Update& initial, SimulationConf
       spray_(seed, config_.spray) {
   state_.glass = config_.windshield.glass;
   state_.roads = surface_->roads_shared();
+  state_.ego = config_.ego;
   apply(initial);
   publish();
 }
@@ -64,9 +65,9 @@ void Simulation::publish() {
   // Under each tire: front left, front right, rear left, rear right.
   const glm::dmat4 to_world = vehicle_to_world(state_.vehicle);
   for (int t = 0; t < kTires; ++t) {
-    const glm::dvec4 local(t < 2 ? car_body::kWheelbase : 0.0,
-                           t % 2 == 0 ? car_body::kTrackHalfWidth : -car_body::kTrackHalfWidth, 0.0,
-                           1.0);
+    const double half_track = 0.5 * config_.ego.track_m;
+    const glm::dvec4 local(t < 2 ? config_.ego.wheelbase_m : 0.0,
+                           t % 2 == 0 ? half_track : -half_track, 0.0, 1.0);
     const glm::dvec2 xy(to_world * local);
     const double water = road_.water_m(xy);
     state_.tires[t] = {water * 1e3, road_.standing_m(xy) * 1e3, road_.state_of(water)};
@@ -148,6 +149,7 @@ SceneState Simulation::inputs_after(double dt_s) const {
   inputs.traffic_lights = state_.traffic_lights;
   inputs.glass = state_.glass;
   inputs.roads = state_.roads;
+  inputs.ego = state_.ego;
   // The road's water as the last step left it (it changes over seconds; the step may be running
   // while the road is drawn).
   inputs.road_water = state_.road_water;
@@ -217,7 +219,8 @@ void Simulation::spray_step() {
     s.state.position_m += state.velocity_mps * ahead;
     sources.push_back(s);
   };
-  add(0, state_.vehicle, glm::dvec3(4.5, 1.8, 1.47), VehicleClass::kCar);
+  // (The spray's car is 4.5 m of the 4.6: its hull, bumpers aside.)
+  add(0, state_.vehicle, config_.ego.size_m * glm::dvec3(4.5 / 4.6, 1.0, 1.0), VehicleClass::kCar);
   for (const TrafficVehicle& other : state_.traffic)
     add(other.id == UINT32_MAX ? other.id : other.id + 1, other.state, other.size_m,
         other.vehicle_class);

@@ -33,6 +33,7 @@ struct AdvanceTiming {
 struct SimulationConfig {
   double sub_step_s = 1.0 / 240.0;           // fixed, so that lockstep runs reproduce
   std::shared_ptr<const RoadNetwork> roads;  // null: the built-in track
+  EgoGeometry ego;
   WindshieldConfig windshield;
   GlassWaterMapConfig water_map;
   RainFieldConfig rain;
@@ -72,6 +73,7 @@ struct SceneState {
   // The roads the session drives on (road_network.hpp): the built-in track's unless the session
   // brought its own.
   std::shared_ptr<const RoadNetwork> roads;
+  EgoGeometry ego;
 };
 
 class Simulation {

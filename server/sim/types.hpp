@@ -118,6 +118,17 @@ struct CameraPose {
   Rotation rotation;           // relative to the vehicle frame
 };
 
+// The ego car's geometry, from the point on the ground under its rear axle's centre (its pose's
+// reference point): the contract's EgoVehicle. The defaults are the car the cabin (its windshield,
+// dashboard and bonnet) is built for; another size scales the car seen from outside and its spray,
+// not the cabin.
+struct EgoGeometry {
+  glm::dvec3 size_m{4.6, 1.8, 1.47};  // length, width, height
+  double wheelbase_m = 2.7;
+  double track_m = 1.56;               // between the wheels' centres across
+  glm::dvec3 eye_m{1.05, 0.37, 1.22};  // the driver's eye: the COCKPIT and RAIN views' camera
+};
+
 struct ViewSpec {
   View view = View::kCockpit;
   int width = 640;
@@ -134,6 +145,9 @@ struct ViewSpec {
   std::optional<double> aperture_mm;
   // The exposure (s): a rain streak is a drop's motion during it. Absent: 1/60 s.
   std::optional<double> exposure_s;
+  // The driver's eye in the vehicle frame (the session's EgoGeometry): where the COCKPIT and RAIN
+  // views look from without a camera of their own.
+  glm::dvec3 eye_m = EgoGeometry{}.eye_m;
 };
 
 // A view of this size with every other setting at its default.

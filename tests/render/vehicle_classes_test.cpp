@@ -1,5 +1,6 @@
 // The traffic's classes on pictures: a truck, a bus and a motorbike seen from the side stand as
-// long and as tall in the image as their sizes say, each in its own shape.
+// long and as tall in the image as their sizes say, each in its own shape. The ego car's geometry
+// (EgoGeometry): its size seen from outside, its eye in the cabin.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -80,6 +81,65 @@ TEST_F(VehicleClassesTest, EachClassStandsAsLongAndTallAsItsSize) {
     EXPECT_NEAR(x1 - x0 + 1, expected_w, 0.05 * expected_w + 2.0) << static_cast<int>(c);
     EXPECT_NEAR(y1 - y0 + 1, expected_h, 0.05 * expected_h + 2.0) << static_cast<int>(c);
   }
+}
+
+// The changed pixels' columns (x0, x1) and rows (y0, y1) of an image against another.
+glm::ivec4 changed_box(const RgbaImage& image, const RgbaImage& base) {
+  glm::ivec4 box(image.width, -1, image.height, -1);
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const std::size_t i = (static_cast<std::size_t>(y) * image.width + x) * 4;
+      int d = 0;
+      for (int k = 0; k < 3; ++k)
+        d = std::max(d, std::abs(image.pixels[i + k] - base.pixels[i + k]));
+      if (d > 24)
+        box = {std::min(box.x, x), std::max(box.y, x), std::min(box.z, y), std::max(box.w, y)};
+    }
+  }
+  return box;
+}
+
+TEST_F(VehicleClassesTest, TheEgoCarIsAsLongAsItsSizeAndItsDriverSeesFromItsEye) {
+  // From its right side, 12 m off, looking square at it: a default car, then one 6.9 m long
+  // (1.5 times) and 2 m tall.
+  sim::SceneState s = dry_scene();
+  const sim::ViewSpec side =
+      posed_view(sim::View::kRoad, kWidth, kHeight, {1.3, -12.0, 1.5}, 90.0, 0.0, 40.0);
+  sim::SceneState empty = s;
+  empty.ego.size_m = glm::dvec3(1e-4);  // out of sight (the camera goes with the car)
+  const RgbaImage ground = render(side, empty);
+  const glm::ivec4 normal = changed_box(render(side, s), ground);
+  s.ego.size_m = {6.9, 1.8, 2.0};
+  const glm::ivec4 long_car = changed_box(render(side, s), ground);
+  const double length_ratio = static_cast<double>(long_car.y - long_car.x) / (normal.y - normal.x);
+  const double height_ratio = static_cast<double>(long_car.w - long_car.z) / (normal.w - normal.z);
+  std::printf("ego car 4.6 x 1.47 m: %d x %d px; 6.9 x 2.0 m: %d x %d px (%.2f, %.2f)\n",
+              normal.y - normal.x, normal.w - normal.z, long_car.y - long_car.x,
+              long_car.w - long_car.z, length_ratio, height_ratio);
+  EXPECT_NEAR(length_ratio, 1.5, 0.08);
+  EXPECT_NEAR(height_ratio, 2.0 / 1.47, 0.1);
+  // The driver's eye 12 cm higher (a tall driver): the bonnet (red) sinks in the COCKPIT view,
+  // and the windshield's top edge with the headliner comes down into it.
+  sim::SceneState d = dry_scene();
+  sim::ViewSpec cockpit = sim::view_spec(sim::View::kCockpit, kWidth, kHeight);
+  const glm::dvec3 eye = cockpit.eye_m;
+  const RgbaImage low = render(cockpit, d);
+  cockpit.eye_m = eye + glm::dvec3(0.0, 0.0, 0.12);
+  const RgbaImage high = render(cockpit, d);
+  if (const char* dir = std::getenv("DOWNPOUR_TEST_IMAGES")) {
+    testing::write_png(std::string(dir) + "/ego_eye_low.png", low);
+    testing::write_png(std::string(dir) + "/ego_eye_high.png", high);
+  }
+  auto bonnet_top = [&](const RgbaImage& image) {
+    for (int y = 0; y < kHeight; ++y) {
+      const std::size_t i = (static_cast<std::size_t>(y) * kWidth + kWidth / 2) * 4;
+      if (image.pixels[i] > image.pixels[i + 1] + 20) return y;
+    }
+    return kHeight;
+  };
+  std::printf("the bonnet's top in the middle column: eye at %.2f m row %d, at %.2f m row %d\n",
+              eye.z, bonnet_top(low), eye.z + 0.12, bonnet_top(high));
+  EXPECT_GT(bonnet_top(high), bonnet_top(low) + 5);
 }
 
 }  // namespace

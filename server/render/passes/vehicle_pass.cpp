@@ -43,7 +43,10 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
       frame.spec.view == sim::View::kCockpit || frame.spec.view == sim::View::kRain;
   const bool flash_on = sim::indicator_lit(frame.scene.sim_time_s);
   const sim::Weather& weather = frame.scene.weather;
-  prepare(frame.vehicle_to_world, glm::vec3(0.42f, 0.05f, 0.04f),
+  // Seen from outside, at the session's size (the cabin keeps the default car's).
+  const glm::vec3 ego_scale =
+      cockpit ? glm::vec3(1.0f) : glm::vec3(frame.scene.ego.size_m / sim::EgoGeometry{}.size_m);
+  prepare(glm::scale(frame.vehicle_to_world, ego_scale), glm::vec3(0.42f, 0.05f, 0.04f),
           shown_lights(frame.scene.ego_lights, weather), flash_on);
   hull_.draw();
   if (!cockpit) upper_.draw();

@@ -64,6 +64,42 @@ TEST(ValidationTest, NonFiniteVehiclePosition) {
   EXPECT_TRUE(invalid_naming(create(r), "initial.vehicle.position_m.x"));
 }
 
+TEST(ValidationTest, EgoGeometryDefaultsAndRanges) {
+  v1::CreateSessionRequest r = good_request();
+  session::SessionConfig config;
+  sim::Update initial;
+  ASSERT_TRUE(to_session_config(r, Limits{}, &config, &initial).ok());
+  EXPECT_EQ(config.ego.size_m, sim::EgoGeometry{}.size_m);
+  EXPECT_EQ(config.ego.wheelbase_m, 2.7);
+  EXPECT_EQ(config.views[0].eye_m, sim::EgoGeometry{}.eye_m);
+  // A van: longer, taller, the driver higher up and further forward.
+  v1::EgoVehicle* ego = r.mutable_ego();
+  ego->mutable_size_m()->set_x(5.3);
+  ego->mutable_size_m()->set_y(2.0);
+  ego->mutable_size_m()->set_z(2.2);
+  ego->set_wheelbase_m(3.3);
+  ego->set_track_m(1.7);
+  ego->mutable_eye_m()->set_x(1.4);
+  ego->mutable_eye_m()->set_y(0.4);
+  ego->mutable_eye_m()->set_z(1.3);
+  ASSERT_TRUE(to_session_config(r, Limits{}, &config, &initial).ok());
+  EXPECT_EQ(config.ego.size_m, glm::dvec3(5.3, 2.0, 2.2));
+  EXPECT_EQ(config.ego.wheelbase_m, 3.3);
+  EXPECT_EQ(config.ego.track_m, 1.7);
+  EXPECT_EQ(config.views[0].eye_m, glm::dvec3(1.4, 0.4, 1.3));
+  // Out of range, each named.
+  auto refused = [&](auto change, const std::string& field) {
+    v1::CreateSessionRequest bad = r;
+    change(bad.mutable_ego());
+    EXPECT_TRUE(invalid_naming(create(bad), field)) << field;
+  };
+  refused([](v1::EgoVehicle* e) { e->mutable_size_m()->set_x(40.0); }, "ego.size_m.x");
+  refused([](v1::EgoVehicle* e) { e->mutable_size_m()->set_z(kNaN); }, "ego.size_m.z");
+  refused([](v1::EgoVehicle* e) { e->set_wheelbase_m(5.0); }, "ego.wheelbase_m");
+  refused([](v1::EgoVehicle* e) { e->set_track_m(2.5); }, "ego.track_m");
+  refused([](v1::EgoVehicle* e) { e->mutable_eye_m()->set_z(1.6); }, "ego.eye_m.z");
+}
+
 TEST(ValidationTest, RainRateOutOfRange) {
   for (double bad : {600.0, -1.0, kNaN}) {
     v1::Update u;
