@@ -1,0 +1,135 @@
+#include "downpour/client.hpp"
+
+#include <utility>
+
+namespace downpour::client {
+
+Error::Error(const grpc::Status& status)
+    : std::runtime_error(status.error_message()), code_(status.error_code()) {}
+
+namespace {
+
+void check(const grpc::Status& status) {
+  if (!status.ok()) throw Error(status);
+}
+
+}  // namespace
+
+Client::Client(Options options) : options_(std::move(options)) {
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(options_.max_message_mb << 20);
+  std::shared_ptr<grpc::ChannelCredentials> credentials;
+  if (options_.tls_ca_pem.empty()) {
+    credentials = grpc::InsecureChannelCredentials();
+  } else {
+    grpc::SslCredentialsOptions tls;
+    tls.pem_root_certs = options_.tls_ca_pem;
+    credentials = grpc::SslCredentials(tls);
+  }
+  channel_ = grpc::CreateCustomChannel(options_.target, credentials, args);
+  stub_ = v1::Downpour::NewStub(channel_);
+}
+
+void Client::prepare(grpc::ClientContext& context, bool with_timeout) const {
+  if (!options_.token.empty()) context.AddMetadata("authorization", "Bearer " + options_.token);
+  if (with_timeout) context.set_deadline(std::chrono::system_clock::now() + options_.timeout);
+}
+
+v1::SessionInfo Client::create_session(const v1::CreateSessionRequest& request) {
+  grpc::ClientContext context;
+  prepare(context);
+  v1::SessionInfo info;
+  check(stub_->CreateSession(&context, request, &info));
+  return info;
+}
+
+void Client::close_session(const std::string& session_id) {
+  grpc::ClientContext context;
+  prepare(context);
+  v1::CloseSessionRequest request;
+  request.set_session_id(session_id);
+  v1::CloseSessionResponse response;
+  check(stub_->CloseSession(&context, request, &response));
+}
+
+std::vector<v1::SessionInfo> Client::list_sessions() {
+  grpc::ClientContext context;
+  prepare(context);
+  v1::ListSessionsResponse response;
+  check(stub_->ListSessions(&context, v1::ListSessionsRequest(), &response));
+  return {response.sessions().begin(), response.sessions().end()};
+}
+
+v1::ServerStats Client::stats() {
+  grpc::ClientContext context;
+  prepare(context);
+  v1::ServerStats stats;
+  check(stub_->GetStats(&context, v1::GetStatsRequest(), &stats));
+  return stats;
+}
+
+LockstepSession::LockstepSession(Client& client, v1::CreateSessionRequest request)
+    : client_(client) {
+  request.set_mode(v1::MODE_LOCKSTEP);
+  info_ = client_.create_session(request);
+}
+
+LockstepSession::~LockstepSession() {
+  try {
+    client_.close_session(info_.session_id());
+  } catch (const Error&) {
+    // Gone already (closed for idleness, the server drained): nothing to close.
+  }
+}
+
+std::vector<v1::Frame> LockstepSession::step(double dt_s, const v1::Update& update) {
+  grpc::ClientContext context;
+  client_.prepare(context);
+  v1::StepRequest request;
+  request.set_session_id(info_.session_id());
+  *request.mutable_update() = update;
+  request.set_dt_s(dt_s);
+  v1::StepResponse response;
+  check(client_.stub().Step(&context, request, &response));
+  return {response.frames().begin(), response.frames().end()};
+}
+
+RealtimeSession::RealtimeSession(Client& client, v1::CreateSessionRequest request,
+                                 FrameHandler on_frame)
+    : client_(client) {
+  request.set_mode(v1::MODE_REALTIME);
+  info_ = client_.create_session(request);
+  client_.prepare(watch_context_, false);
+  reader_ = std::thread([this, on_frame = std::move(on_frame)] {
+    v1::WatchFramesRequest watch;
+    watch.set_session_id(info_.session_id());
+    auto stream = client_.stub().WatchFrames(&watch_context_, watch);
+    v1::Frame frame;
+    while (stream->Read(&frame)) {
+      ++received_;
+      if (on_frame) on_frame(frame);
+    }
+    stream->Finish();
+  });
+}
+
+RealtimeSession::~RealtimeSession() {
+  watch_context_.TryCancel();
+  if (reader_.joinable()) reader_.join();
+  try {
+    client_.close_session(info_.session_id());
+  } catch (const Error&) {
+  }
+}
+
+void RealtimeSession::update(const v1::Update& update) {
+  grpc::ClientContext context;
+  client_.prepare(context);
+  v1::UpdateRequest request;
+  request.set_session_id(info_.session_id());
+  *request.mutable_update() = update;
+  v1::UpdateResponse response;
+  check(client_.stub().Update(&context, request, &response));
+}
+
+}  // namespace downpour::client
