@@ -1,8 +1,10 @@
 #include "server/sim/track_opendrive.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace downpour::sim {
 namespace {
@@ -84,21 +86,26 @@ std::string track_to_opendrive(const Track& track) {
   // each lane's height; the markings as the render draws them (a double centre line, dashed
   // lane dividers, solid edge lines).
   const CrossSection& c = track.cross_section();
+  // Each side's lanes by id, from the top down as the standard lists them: the left's from the
+  // outermost in, the right's from the innermost out (SUMO's netconvert reads them in that order).
   const auto side = [&](int sign) {
-    std::string out;
+    std::vector<std::string> lanes_out;
     const int lanes = c.lanes_each_way;
     for (int i = 1; i <= lanes; ++i) {
       const double inner = (i - 1) * c.lane_width_m, outer = i * c.lane_width_m;
-      out += lane(sign * i, "driving", c.lane_width_m, -c.crown_slope * inner,
-                  -c.crown_slope * outer, i < lanes ? "broken" : "solid", i < lanes ? 0.15 : 0.2);
+      lanes_out.push_back(lane(sign * i, "driving", c.lane_width_m, -c.crown_slope * inner,
+                               -c.crown_slope * outer, i < lanes ? "broken" : "solid",
+                               i < lanes ? 0.15 : 0.2));
     }
     const double edge = lanes * c.lane_width_m;
-    out += lane(sign * (lanes + 1), "shoulder", c.shoulder_m, -c.crown_slope * edge,
-                -c.crown_slope * (edge + c.shoulder_m), nullptr, 0.0);
+    lanes_out.push_back(lane(sign * (lanes + 1), "shoulder", c.shoulder_m, -c.crown_slope * edge,
+                             -c.crown_slope * (edge + c.shoulder_m), nullptr, 0.0));
+    if (sign > 0) std::reverse(lanes_out.begin(), lanes_out.end());
+    std::string out;
+    for (const std::string& l : lanes_out) out += l;
     return out;
   };
   x += "    <lanes>\n";
-  // Listed outwards from the centre: left ids count up, right ones down.
   x += "      <laneSection s=\"0\">\n      <left>\n" + side(1) + R"(      </left>
       <center>
         <lane id="0" type="none" level="false">

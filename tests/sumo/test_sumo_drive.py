@@ -1,4 +1,5 @@
-"""Eclipse SUMO drives a session of the real server in lockstep (ctest label sumo).
+"""Eclipse SUMO drives a session of the real server in lockstep (ctest label sumo); and SUMO's
+netconvert reads the built-in track's OpenDRIVE export.
 
 The road is the same on both sides: the server has tests/data/maps/sumo_grid.xodr (a SUMO grid
 converted to OpenDRIVE by netconvert) as a map, and SUMO runs on the network netconvert makes back
@@ -7,7 +8,9 @@ takes it off along its lane among traffic (cars, a truck, a bus, a motorbike ahe
 """
 
 import io
+import math
 import os
+import subprocess
 import shutil
 import sys
 import tempfile
@@ -127,6 +130,39 @@ class SumoDriveTest(ServerProcessCase):
         self.assertLess(max(stand), 0.5)
         self.assertGreater(min(drive), 2.0 * max(stand) + 0.3)
         self.assertGreater(min(asphalt), 0.4)
+
+
+class ExportedTrackTest(unittest.TestCase):
+    """The built-in track as OpenDRIVE (downpour-scenes --xodr), read by SUMO's netconvert: two
+    lanes each way whose centres lie 1.75 and 5.25 m either side of the track's centreline."""
+
+    def test_netconvert_reads_the_track(self):
+        scenes = os.path.join(os.path.dirname(os.environ["DOWNPOUR_SERVER"]), "downpour-scenes")
+        sys.path.append(os.path.join(os.environ.get("SUMO_HOME", "/usr/share/sumo"), "tools"))
+        import sumolib  # noqa: E402
+        with tempfile.TemporaryDirectory() as folder:
+            xodr, net = os.path.join(folder, "track.xodr"), os.path.join(folder, "track.net.xml")
+            subprocess.run([scenes, "--xodr", xodr], check=True, capture_output=True)
+            opendrive_to_sumo(xodr, net)
+            network = sumolib.net.readNet(net)
+
+        def offset(x, y):  # from the centreline: straights at y 0 and 500, half circles of 250 m
+            if 0.0 <= x <= 900.0:
+                return min(abs(y), abs(y - 500.0))
+            centre = (900.0, 250.0) if x > 900.0 else (0.0, 250.0)
+            return abs(math.hypot(x - centre[0], y - centre[1]) - 250.0)
+
+        offsets = []
+        for edge in network.getEdges():
+            if edge.getFunction() != "":
+                continue
+            self.assertEqual(len(edge.getLanes()), 2, edge.getID())
+            for lane, expected in zip(edge.getLanes(), (5.25, 1.75)):  # SUMO's 0: the outer
+                worst = max(abs(offset(x, y) - expected) for x, y in lane.getShape())
+                offsets.append(worst)
+                self.assertLess(worst, 0.05, f"lane {lane.getID()}")
+        print(f"\n{len(offsets)} lanes, centres within {max(offsets) * 100:.1f} cm of the track's")
+        self.assertEqual(len(offsets), 8)
 
 
 if __name__ == "__main__":
