@@ -97,7 +97,9 @@ std::vector<Light> build_lights(const sim::SceneState& scene,
                                 const glm::vec3& camera_m, const LightSetConfig& c) {
   std::vector<Light> out;
   const bool flash_on = sim::indicator_lit(scene.sim_time_s);
-  add_vehicle(sim::vehicle_to_world(scene.vehicle), glm::vec3(1.0f), c.headlamp_m, c.tail_lamp_m,
+  // The ego car's lamps where its shape, at the session's size, has them.
+  add_vehicle(sim::vehicle_to_world(scene.vehicle),
+              glm::vec3(scene.ego.size_m / sim::EgoGeometry{}.size_m), c.headlamp_m, c.tail_lamp_m,
               shown_lights(scene.ego_lights, scene.weather), flash_on, -1, c, out);
   for (std::size_t i = 0; i < scene.traffic.size(); ++i) {
     const sim::TrafficVehicle& t = scene.traffic[i];

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <stdexcept>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -64,7 +65,9 @@ void road_piece(const sim::RoadNetwork& roads, int road, double s0, double s1,
     int per_row = 0;
     for (const double s : rows) {
       const sim::TrackFrame f = roads.frame(road, s);
-      sim::LaneLayout layout = roads.lanes(road, s);
+      // The piece's own lanes and heights, at its end too (where the next section's may differ).
+      const double se = std::min(s, s1 - 1e-6);
+      sim::LaneLayout layout = roads.lanes(road, se);
       // No lines across a junction: its connecting roads overlap, and their marks (which SUMO's
       // netconvert, for one, writes) would draw a tangle of curves over it.
       if (roads.connecting(road)) layout.marks.assign(layout.marks.size(), sim::LaneMark{});
@@ -83,7 +86,7 @@ void road_piece(const sim::RoadNetwork& roads, int road, double s0, double s1,
       // where another road's pavement lies beyond the edge (the other direction's lanes on a road
       // of one-way halves, a junction): its stations all at the edge, its triangles empty.
       auto verge = [&](double edge, double way) {
-        const double z = roads.surface_height({road, s, edge});
+        const double z = roads.surface_height({road, se, edge});
         const glm::dvec2 beyond = glm::dvec2(f.position) + f.left * (edge + way * 0.5);
         const sim::RoadPlace other = roads.project(beyond, 30.0);
         const bool covered =
@@ -111,10 +114,14 @@ void road_piece(const sim::RoadNetwork& roads, int road, double s0, double s1,
               mark_attribute(layout.marks[right], (right > centre) - (right < centre));
           attr.mark_left = mark_attribute(layout.marks[left], (left > centre) - (left < centre));
         }
-        vertex(t, roads.surface_height({road, s, t}), cross_slope(roads, road, s, t, span), attr);
+        vertex(t, roads.surface_height({road, se, t}), cross_slope(roads, road, se, t, span), attr);
       }
       verge(span.left, 1.0);
-      per_row = static_cast<int>(m.vertices.size() - first);
+      const auto row = static_cast<int>(m.vertices.size() - first);
+      if (per_row != 0 && row != per_row) {
+        throw std::logic_error("a road piece's rows differ in their columns");
+      }
+      per_row = row;
     }
     // Each quad's two triangles end on its right column's vertices (OpenGL's provoking vertex is
     // a triangle's last): (i + 1, i + 1 + n, i) and (i + 1 + n, i + n, i), counter-clockwise as

@@ -14,7 +14,9 @@ namespace downpour::render {
 
 namespace {
 
-// Geometry prepared ahead of its first frame, by network, until the render thread takes it.
+// Geometry prepared ahead of its first frame, by network, until the render thread takes it; then
+// null, marking the network's world as made (a later session on it prepares nothing), until the
+// network goes.
 struct Prepared {
   std::mutex mutex;
   std::map<const sim::RoadNetwork*,
@@ -44,7 +46,7 @@ WorldGeometry build_world_geometry(const sim::RoadNetwork& roads) {
 }
 
 void prepare_world(const std::shared_ptr<const sim::RoadNetwork>& roads) {
-  if (!roads) return;
+  if (!roads || roads == sim::built_in_roads()) return;
   {
     std::lock_guard lock(prepared().mutex);
     prepared().drop_expired();
@@ -76,10 +78,12 @@ const World& Worlds::get(const std::shared_ptr<const sim::RoadNetwork>& given) {
   {
     std::lock_guard lock(prepared().mutex);
     prepared().drop_expired();
-    if (const auto it = prepared().worlds.find(roads.get()); it != prepared().worlds.end()) {
-      geometry = std::move(it->second.second);
-      prepared().worlds.erase(it);
+    auto it = prepared().worlds.find(roads.get());
+    if (it == prepared().worlds.end()) {
+      it = prepared().worlds.emplace(roads.get(), std::make_pair(roads, nullptr)).first;
     }
+    geometry = std::move(it->second.second);
+    it->second.second.reset();
   }
   const auto t0 = std::chrono::steady_clock::now();
   const bool built_here = !geometry;

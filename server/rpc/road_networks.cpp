@@ -39,11 +39,14 @@ std::shared_ptr<const sim::RoadNetwork> RoadNetworks::parse(const std::string& k
                                                             const std::string& text,
                                                             const std::string& field,
                                                             grpc::Status* status) {
+  // A hit is the same text, compared whole (a hash alone could be made to collide, giving one
+  // client another's roads).
+  auto same = [&](const Cached& c) { return c.text == text; };
   {
     std::lock_guard lock(mutex_);
-    std::erase_if(cache_, [](const auto& e) { return e.second.expired(); });
-    if (const auto it = cache_.find(key); it != cache_.end()) {
-      if (auto roads = it->second.lock()) return roads;
+    std::erase_if(cache_, [](const auto& e) { return e.second.roads.expired(); });
+    if (const auto it = cache_.find(key); it != cache_.end() && same(it->second)) {
+      if (auto roads = it->second.roads.lock()) return roads;
     }
   }
   // Parsed outside the lock: a large file does not hold up another session's.
@@ -59,10 +62,10 @@ std::shared_ptr<const sim::RoadNetwork> RoadNetworks::parse(const std::string& k
     return nullptr;
   }
   std::lock_guard lock(mutex_);
-  if (const auto it = cache_.find(key); it != cache_.end()) {
-    if (auto first = it->second.lock()) return first;  // parsed meanwhile by another request
+  if (const auto it = cache_.find(key); it != cache_.end() && same(it->second)) {
+    if (auto first = it->second.roads.lock()) return first;  // parsed meanwhile by another request
   }
-  cache_[key] = roads;
+  cache_[key] = {roads, text};
   return roads;
 }
 

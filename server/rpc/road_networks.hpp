@@ -40,7 +40,11 @@ class RoadNetworks {
   std::string maps_dir_;
   road::Limits limits_;
   std::mutex mutex_;
-  std::map<std::string, std::weak_ptr<const sim::RoadNetwork>> cache_;
+  struct Cached {
+    std::weak_ptr<const sim::RoadNetwork> roads;
+    std::string text;  // what was parsed, to tell it from another text of the same key
+  };
+  std::map<std::string, Cached> cache_;
 };
 
 }  // namespace downpour::rpc

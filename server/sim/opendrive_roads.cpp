@@ -16,6 +16,12 @@ namespace {
 constexpr double kSampleStepM = 2.0;
 constexpr double kMinCellM = 16.0;
 constexpr int kMaxCellsAcross = 1024;
+// A session's roads may span this much, and a road's paved width reach this far from its reference
+// line: beyond, a file describes no road a car drives on, and would only cost.
+constexpr double kMaxExtentM = 100'000.0;
+constexpr double kMaxReachM = 200.0;
+// project_near() searches every road near a place its guess's road does not hold, within this.
+constexpr double kNearSearchM = 30.0;
 
 // Lane types a car drives in (its wheel paths worn into it, its lines dashed between them).
 bool driven(const std::string& type) {
@@ -67,7 +73,16 @@ OpenDriveRoads::OpenDriveRoads(road::Network network) : network_(std::move(netwo
       hi_ = glm::max(hi_, glm::dvec2(p.x, p.y) + reach);
     }
   }
+  if (widest_m_ > kMaxReachM) {
+    throw std::invalid_argument("a road's lanes reach " + std::to_string(widest_m_) +
+                                " m from its reference line (at most " +
+                                std::to_string(kMaxReachM) + ")");
+  }
   const glm::dvec2 extent = hi_ - lo_;
+  if (std::max(extent.x, extent.y) > kMaxExtentM) {
+    throw std::invalid_argument("the roads span " + std::to_string(std::max(extent.x, extent.y)) +
+                                " m (at most " + std::to_string(kMaxExtentM) + ")");
+  }
   cell_m_ = std::max(kMinCellM, std::max(extent.x, extent.y) / kMaxCellsAcross);
   cells_ = glm::max(glm::ivec2(glm::ceil(extent / cell_m_)), glm::ivec2(1));
   // A counting sort of the samples by cell.
@@ -84,6 +99,42 @@ OpenDriveRoads::OpenDriveRoads(road::Network network) : network_(std::move(netwo
   std::vector<std::uint32_t> next(cell_start_.begin(), cell_start_.end() - 1);
   for (std::size_t i = 0; i < samples_.size(); ++i) {
     cell_samples_[next[cell[i]]++] = static_cast<std::uint32_t>(i);
+  }
+  // Each cell's nearest sample, near enough: its own samples' nearest to its centre, carried to
+  // the cells without by two sweeps across the grid (each cell takes a neighbour's if nearer).
+  constexpr std::uint32_t kNone = UINT32_MAX;
+  near_.assign(count, kNone);
+  auto centre = [&](int x, int y) { return lo_ + (glm::dvec2(x, y) + 0.5) * cell_m_; };
+  auto d2 = [&](std::uint32_t k, int x, int y) {
+    const glm::dvec2 d = samples_[k].xy - centre(x, y);
+    return glm::dot(d, d);
+  };
+  for (int y = 0; y < cells_.y; ++y) {
+    for (int x = 0; x < cells_.x; ++x) {
+      const std::size_t c = static_cast<std::size_t>(y) * cells_.x + x;
+      for (std::uint32_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
+        const std::uint32_t i = cell_samples_[k];
+        if (near_[c] == kNone || d2(i, x, y) < d2(near_[c], x, y)) near_[c] = i;
+      }
+    }
+  }
+  auto take = [&](int x, int y, int nx, int ny) {
+    if (nx < 0 || ny < 0 || nx >= cells_.x || ny >= cells_.y) return;
+    const std::uint32_t other = near_[static_cast<std::size_t>(ny) * cells_.x + nx];
+    std::uint32_t& mine = near_[static_cast<std::size_t>(y) * cells_.x + x];
+    if (other != kNone && (mine == kNone || d2(other, x, y) < d2(mine, x, y))) mine = other;
+  };
+  for (int y = 0; y < cells_.y; ++y) {
+    for (int x = 0; x < cells_.x; ++x) {
+      take(x, y, x - 1, y), take(x, y, x, y - 1), take(x, y, x - 1, y - 1),
+          take(x, y, x + 1, y - 1);
+    }
+  }
+  for (int y = cells_.y - 1; y >= 0; --y) {
+    for (int x = cells_.x - 1; x >= 0; --x) {
+      take(x, y, x + 1, y), take(x, y, x, y + 1), take(x, y, x + 1, y + 1),
+          take(x, y, x - 1, y + 1);
+    }
   }
 }
 
@@ -189,16 +240,22 @@ RoadPlace OpenDriveRoads::project(glm::dvec2 xy, double fine_within_m) const {
     double d2 = std::numeric_limits<double>::max();
     double s = 0.0;
   };
-  std::vector<std::pair<int, Nearest>> roads;
-  double best_d2 = std::numeric_limits<double>::max();
   const glm::ivec2 centre = cell_of(xy);
+  // A sample near the place, from its cell's: the search need go no further than it (and its
+  // road's reach), and where even that is beyond fine_within_m, it is the answer.
+  const Sample& hint = samples_[near_[static_cast<std::size_t>(centre.y) * cells_.x + centre.x]];
+  double best_d2 = glm::dot(hint.xy - xy, hint.xy - xy);
+  if (std::sqrt(best_d2) > fine_within_m + widest_m_ + 2.0 * kSampleStepM) {
+    const TrackFrame f = frame(hint.road, hint.s);
+    return {hint.road, hint.s, glm::dot(xy - glm::dvec2(f.position), f.left)};
+  }
+  thread_local std::vector<std::pair<int, Nearest>> roads;
+  roads.clear();
+  roads.push_back({hint.road, {best_d2, hint.s}});
   const int rings = std::max(cells_.x, cells_.y);
   for (int ring = 0; ring <= rings; ++ring) {
     const double ring_from = (ring - 1) * cell_m_;
-    if (best_d2 < std::numeric_limits<double>::max()) {
-      const double reach = std::sqrt(best_d2) + widest_m_ + 2.0 * kSampleStepM;
-      if (ring_from > reach) break;
-    }
+    if (ring_from > std::sqrt(best_d2) + widest_m_ + 2.0 * kSampleStepM) break;
     for (int y = centre.y - ring; y <= centre.y + ring; ++y) {
       if (y < 0 || y >= cells_.y) continue;
       const bool edge_row = y == centre.y - ring || y == centre.y + ring;
@@ -255,7 +312,8 @@ RoadPlace OpenDriveRoads::project_near(glm::dvec2 xy, const RoadPlace& guess) co
     const RoadPlace place = foot(guess.road, xy, guess.s);
     if (off_road(xy, place) == 0.0) return place;
   }
-  return project(xy);
+  // Off its road: the road that holds it, if one is near; else as good as scenery needs.
+  return project(xy, kNearSearchM);
 }
 
 }  // namespace downpour::sim

@@ -50,6 +50,7 @@ class OpenDriveRoads final : public RoadNetwork {
   std::vector<Sample> samples_;
   // Samples by grid cell (kCellM square from lo_), as index ranges into cell_samples_.
   std::vector<std::uint32_t> cell_start_, cell_samples_;
+  std::vector<std::uint32_t> near_;  // by cell: a sample near it (its nearest, or nearly)
   glm::ivec2 cells_{0};
   double cell_m_ = 16.0;
   glm::dvec2 lo_{0.0}, hi_{0.0};

@@ -87,6 +87,7 @@ class RoadNetwork {
   // (cheaper, for scenery).
   virtual RoadPlace project(glm::dvec2 xy, double fine_within_m = 1e30) const = 0;
   // The same, starting from a place a few metres away (a neighbouring position's): much cheaper.
+  // A place on no road may get scenery's answer (an OpenDRIVE network's, beyond 30 m of a road).
   virtual RoadPlace project_near(glm::dvec2 xy, const RoadPlace& guess) const = 0;
 
   // The roads' extent in x and y, paved widths included.

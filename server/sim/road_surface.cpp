@@ -82,12 +82,17 @@ void RoadSurface::add_piece(int road, double s0, double s1, RandomStream& random
         d.lateral =
             left ? p.span.left - random.uniform(0.0, 1.5) : p.span.right + random.uniform(0.0, 1.5);
       }
-      // Clear of the crown's top by kCrownClearM, and its centre on the paved width.
+      // Clear of the crown's top by kCrownClearM, and its centre on the paved width (none where
+      // its side of the road has no room for it: a narrow or one-sided road). Kept a radius
+      // inside the piece along the road, so that the next piece need not look back for it.
       const bool left = d.lateral >= crown;
       const double room = left ? p.span.left - crown : crown - p.span.right;
-      const double from_crown =
-          std::clamp(std::abs(d.lateral - crown), d.radius + kCrownClearM, std::max(room, 0.0));
+      const double clear = d.radius + kCrownClearM;
+      if (room < clear) continue;
+      const double from_crown = std::clamp(std::abs(d.lateral - crown), clear, room);
       d.lateral = crown + (left ? from_crown : -from_crown);
+      if (!roads_->road_loops(road) && length > 2.0 * d.radius)
+        d.s = std::clamp(d.s, s0 + d.radius, s1 - d.radius);
       p.depressions[b].push_back(d);
     }
   }

@@ -86,7 +86,8 @@ class SumoDriveTest(ServerProcessCase):
                 weather = pb.Weather(sun_altitude_deg=40.0, cloudiness=0.3)
                 info = self.client.create_session(
                     [("COCKPIT", 320, 180), ("ROAD", 320, 180)], mode="LOCKSTEP", seed=5,
-                    initial=bridge.update(weather), roads={"map_name": "sumo_grid"})
+                    initial=bridge.update(weather), roads={"map_name": "sumo_grid"},
+                    ego=bridge.ego_vehicle())
                 self.assertEqual(info.road_network, "map:sumo_grid")
                 steps = []
 

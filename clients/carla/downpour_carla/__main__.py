@@ -43,6 +43,8 @@ def main(argv=None):
         blueprint = world.get_blueprint_library().filter("vehicle.*")[0]
         spawned = ego = world.spawn_actor(blueprint, world.get_map().get_spawn_points()[0])
         ego.set_autopilot(True)
+    # The traffic manager's autopilots keep to CARLA's synchronous ticks.
+    carla_client.get_trafficmanager().set_synchronous_mode(True)
     width, height = (int(v) for v in args.size.split("x"))
     bridge = CarlaBridge(world, ego)
     original = world.get_settings()

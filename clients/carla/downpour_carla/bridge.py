@@ -75,14 +75,20 @@ class CarlaBridge:
             setattr(state.lights, key, lamps[key])
         return state
 
-    def update(self, sim_time_s):
-        """The contract's Update for the world as it is now."""
+    def update(self, sim_time_s, max_traffic=64):
+        """The contract's Update for the world as it is now: the ego vehicle, the other vehicles
+        nearest it (the server takes 64) as traffic, the weather."""
         u = pb.Update(sim_time_s=sim_time_s, replace_traffic=True)
         u.vehicle.CopyFrom(self.vehicle_state(self.ego))
         u.weather.CopyFrom(weather(self.world))
-        for actor in self.world.get_actors().filter("vehicle.*"):
-            if actor.id == self.ego.id:
-                continue
+        here = self.ego.get_transform().location
+
+        def distance(actor):
+            there = actor.get_transform().location
+            return (there.x - here.x) ** 2 + (there.y - here.y) ** 2
+
+        others = [a for a in self.world.get_actors().filter("vehicle.*") if a.id != self.ego.id]
+        for actor in sorted(sorted(others, key=distance)[:max_traffic], key=lambda a: a.id):
             attributes = getattr(actor, "attributes", {})
             klass = mapping.vehicle_class(attributes.get("base_type", ""),
                                           int(attributes.get("number_of_wheels", 4)))

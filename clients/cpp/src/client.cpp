@@ -107,7 +107,12 @@ RealtimeSession::RealtimeSession(Client& client, v1::CreateSessionRequest reques
     v1::Frame frame;
     while (stream->Read(&frame)) {
       ++received_;
-      if (on_frame) on_frame(frame);
+      try {
+        if (on_frame) on_frame(frame);
+      } catch (...) {
+        watch_context_.TryCancel();  // the handler gave up: so does the reading
+        break;
+      }
     }
     stream->Finish();
   });

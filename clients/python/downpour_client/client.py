@@ -116,10 +116,11 @@ class DownpourClient:
     def __exit__(self, *exc_info):
         self.close()
 
-    def create_session(self, views, mode="LOCKSTEP", fps=0.0, seed=0, initial=None, roads=None):
+    def create_session(self, views, mode="LOCKSTEP", fps=0.0, seed=0, initial=None, roads=None,
+                       ego=None):
         """Views as ViewSpecs, (view, width, height[, quality]) tuples or dicts -> SessionInfo.
         roads: a RoadNetwork, {"map_name": ...} or {"opendrive_xml": ...}; None, the built-in
-        track."""
+        track. ego: an EgoVehicle (the ego car's geometry); None, the default car's."""
         request = pb.CreateSessionRequest(
             views=[to_view_spec(v) for v in views], mode=mode_value(mode), fps=fps, seed=seed)
         if initial is not None:
@@ -128,6 +129,8 @@ class DownpourClient:
             roads = pb.RoadNetwork(**roads)
         if roads is not None:
             request.roads.CopyFrom(roads)
+        if ego is not None:
+            request.ego.CopyFrom(ego)
         return self.create_session_from(request)
 
     def create_session_from(self, request):

@@ -54,12 +54,12 @@ def main(argv=None):
             SumoBridge(args.net, step_s=args.step) as bridge:
         bridge.add_vehicle("ego", args.ego_route, lane=args.ego_lane, speed=0.0)
         for k in range(args.traffic):
-            bridge.add_vehicle(f"car{k}", args.ego_route, lane=k % 2, depart_pos=25.0 * (k + 1))
+            bridge.add_vehicle(f"car{k}", args.ego_route, lane="free", depart_pos=25.0 * (k + 1))
         bridge.step()
         mode = "REALTIME" if args.realtime else "LOCKSTEP"
         info = client.create_session([("COCKPIT", width, height), ("ROAD", width, height)],
                                      mode=mode, initial=bridge.update(*conditions(0.0)),
-                                     roads=road_network)
+                                     roads=road_network, ego=bridge.ego_vehicle())
         print(f"session {info.session_id} on {info.road_network} ({info.roads} roads)")
         try:
             if args.realtime:

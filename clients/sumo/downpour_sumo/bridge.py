@@ -70,8 +70,8 @@ class SumoBridge:
             self.sumo = None
 
     def add_vehicle(self, vehicle_id, edges, lane=0, depart_pos=0.0, speed=0.0, vtype=None):
-        """A vehicle on a route of edges (SUMO's lane index: 0 the rightmost), driven by SUMO's
-        own models."""
+        """A vehicle on a route of edges (SUMO's lane index: 0 the rightmost; or "free", "best"),
+        driven by SUMO's own models."""
         route = f"route_{vehicle_id}"
         self.sumo.route.add(route, list(edges))
         kwargs = {"departLane": str(lane), "departPos": str(depart_pos),
@@ -103,14 +103,35 @@ class SumoBridge:
         state.lights.reverse = lamps["reverse"]
         return state
 
-    def update(self, weather=None, wipers=None):
+    def ego_vehicle(self):
+        """The session's EgoVehicle: the SUMO ego's size (call once it is in the network)."""
+        v = self.sumo.vehicle
+        ego = pb.EgoVehicle()
+        ego.size_m.x = min(max(v.getLength(self.ego_id), 2.0), 20.0)
+        ego.size_m.y = min(max(v.getWidth(self.ego_id), 1.0), 3.5)
+        ego.size_m.z = min(max(v.getHeight(self.ego_id), 1.0), 5.0)
+        return ego
+
+    def update(self, weather=None, wipers=None, max_traffic=convert.MAX_TRAFFIC):
         """The contract's Update for SUMO's state now: the ego car (if it is in the network) and
-        every other vehicle as traffic; weather and wipers as given (pb messages, or None)."""
+        the other vehicles nearest it (the server takes 64) as traffic; weather and wipers as
+        given (pb messages, or None)."""
         u = pb.Update(sim_time_s=self.time_s, replace_traffic=True)
         present = set(self.sumo.vehicle.getIDList())
+        others = sorted(present - {self.ego_id})
         if self.ego_id in present:
-            u.vehicle.CopyFrom(self._state(self.ego_id, convert.EGO_FRONT_BUMPER_M))
-        for vehicle_id in sorted(present - {self.ego_id}):
+            v = self.sumo.vehicle
+            length = min(max(v.getLength(self.ego_id), 2.0), 20.0)
+            u.vehicle.CopyFrom(self._state(
+                self.ego_id, convert.EGO_FRONT_BUMPER_M * length / convert.EGO_LENGTH_M))
+            ex, ey = v.getPosition(self.ego_id)
+
+            def distance(i):
+                x, y = v.getPosition(i)
+                return (x - ex) ** 2 + (y - ey) ** 2
+
+            others = sorted(others, key=lambda i: (distance(i), i))
+        for vehicle_id in sorted(others[:max_traffic]):
             v = self.sumo.vehicle
             klass = convert.vehicle_class(v.getVehicleClass(vehicle_id))
             length = v.getLength(vehicle_id)

@@ -11,7 +11,8 @@ Downpour's pitch is positive nose down: pitch = -slope.
 
 Reference point. SUMO places a vehicle at the middle of its front bumper; Downpour's pose is the
 ground under the rear axle's centre. The ego car's front bumper is 3.65 m ahead of its rear axle
-(the contract's VehicleState); a traffic vehicle's shape is its class's, scaled to its length, so
+at its default 4.6 m (the contract's VehicleState; the bridge gives the session the SUMO ego's size
+and scales that); a traffic vehicle's shape is its class's, scaled to its length, so
 its rear axle lies a fixed share of its length behind the front bumper (REAR_AXLE_FROM_FRONT).
 
 Lamps. TraCI's vehicle signals are bits: 0 right blinker, 1 left blinker, 2 emergency (both), 3
@@ -42,7 +43,9 @@ REAR_AXLE_FROM_FRONT = {
     BUS: (12.0 - 3.4) / 12.0,
     MOTORBIKE: (2.2 - 0.45) / 2.2,
 }
-EGO_FRONT_BUMPER_M = 3.65  # ahead of the ego car's rear axle
+EGO_FRONT_BUMPER_M = 3.65  # ahead of the ego car's rear axle, at its default length
+EGO_LENGTH_M = 4.6  # (the bridge sends the SUMO ego's size as the session's, and scales this)
+MAX_TRAFFIC = 64  # the server's limit on traffic vehicles in an update
 
 SIGNAL_RIGHT, SIGNAL_LEFT, SIGNAL_EMERGENCY, SIGNAL_BRAKE = 1, 2, 4, 8
 SIGNAL_FRONT, SIGNAL_FOG, SIGNAL_HIGH_BEAM, SIGNAL_REVERSE = 16, 32, 64, 128

@@ -80,7 +80,8 @@ class LockstepSession {
 };
 
 // A realtime session: updates apply on arrival; the server renders at the session's rate and a
-// reader thread hands each tick's frames to on_frames (from WatchFrames, one call per frame).
+// reader thread hands each frame to on_frame (from WatchFrames; the views of a tick share its
+// frame_number). An exception thrown by on_frame ends the reading.
 class RealtimeSession {
  public:
   using FrameHandler = std::function<void(const v1::Frame&)>;

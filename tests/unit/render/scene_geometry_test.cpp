@@ -1,0 +1,83 @@
+// The road's meshes built from an OpenDRIVE network: lane sections whose lanes differ in number
+// give each its own mesh, whole and indexed within its vertices; a narrow one-sided road's relief
+// is made without a bowl out of its room.
+#include "server/render/scene_geometry.hpp"
+
+#include <memory>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "server/sim/opendrive_roads.hpp"
+#include "server/sim/road_surface.hpp"
+
+namespace downpour::render {
+namespace {
+
+std::string lane(int id, double width) {
+  return "<lane id=\"" + std::to_string(id) + "\" type=\"driving\"><width sOffset=\"0\" a=\"" +
+         std::to_string(width) +
+         "\" b=\"0\" c=\"0\" d=\"0\"/><roadMark sOffset=\"0\" type=\"broken\" width=\"0.12\"/>"
+         "</lane>";
+}
+
+// A 200 m road: one lane each way for 80 m, then three to the right and none to the left; and a
+// one-way road of a single 2.5 m lane.
+const char* const kHeader = R"(<OpenDRIVE><header revMajor="1" revMinor="6"/>)";
+std::string network() {
+  return std::string(kHeader) + R"(<road id="a" length="200" junction="-1">
+    <planView><geometry s="0" x="0" y="0" hdg="0" length="200"><line/></geometry></planView>
+    <lanes><laneSection s="0"><left>)" +
+         lane(1, 3.5) + R"(</left><center><lane id="0" type="none"/></center><right>)" +
+         lane(-1, 3.5) + R"(</right></laneSection>
+      <laneSection s="80"><center><lane id="0" type="none"/></center><right>)" +
+         lane(-1, 3.5) + lane(-2, 3.5) + lane(-3, 3.0) + R"(</right></laneSection></lanes>
+  </road>
+  <road id="b" length="60" junction="-1">
+    <planView><geometry s="0" x="0" y="100" hdg="0" length="60"><line/></geometry></planView>
+    <lanes><laneSection s="0"><center><lane id="0" type="none"/></center><right>)" +
+         lane(-1, 2.5) + R"(</right></laneSection></lanes>
+  </road></OpenDRIVE>)";
+}
+
+TEST(SceneGeometryTest, LaneSectionsOfDifferentLanesMakeWholeMeshes) {
+  const auto roads = std::make_shared<const sim::OpenDriveRoads>(road::parse_opendrive(network()));
+  const std::vector<std::vector<MeshData>> chunks = build_road_chunks(*roads);
+  ASSERT_FALSE(chunks.empty());
+  std::size_t triangles = 0;
+  for (const std::vector<MeshData>& levels : chunks) {
+    ASSERT_EQ(levels.size(), 3u);
+    for (const MeshData& m : levels) {
+      ASSERT_EQ(m.lanes.size(), m.vertices.size());
+      ASSERT_EQ(m.curvature.size(), m.vertices.size());
+      ASSERT_EQ(m.indices.size() % 3, 0u);
+      for (const std::uint32_t i : m.indices) ASSERT_LT(i, m.vertices.size());
+      triangles += m.indices.size() / 3;
+    }
+  }
+  EXPECT_GT(triangles, 0u);
+  // The second section's mesh reaches 10 m right of the reference line (three lanes), the
+  // first's 3.5 m either side.
+  float rightmost = 0.0f, leftmost = 0.0f;
+  for (const std::vector<MeshData>& levels : chunks) {
+    for (const MeshVertex& v : levels[0].vertices) {
+      if (v.position.y > 50.0f) continue;  // road b
+      if (v.uv.y < 79.0f) leftmost = std::max(leftmost, v.uv.x);
+      if (v.uv.y > 81.0f) rightmost = std::min(rightmost, v.uv.x);
+    }
+  }
+  EXPECT_NEAR(leftmost, 3.5f + 4.0f, 1e-3) << "the left lane and its verge";
+  EXPECT_NEAR(rightmost, -10.0f - 4.0f, 1e-3) << "three lanes and the verge";
+  // The narrow road has no room for bowls beside its crown, and its relief is still sound.
+  const sim::RoadSurface surface(roads, 3);
+  for (double s = 0.0; s < 60.0; s += 0.5) {
+    for (double t = -2.5; t <= 0.0; t += 0.25) {
+      const double r = surface.relief({1, s, t});
+      ASSERT_LE(r, 0.0);
+      ASSERT_GT(r, -0.05);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace downpour::render
