@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <stdexcept>
 #include <string_view>
 
 #include "server/road/opendrive.hpp"
@@ -45,7 +46,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   // As a session's roads.
   using namespace downpour::sim;
-  auto roads = std::make_shared<const OpenDriveRoads>(std::move(net));
+  // Refused as a session's roads (lanes reaching too far, a span too wide): the server answers
+  // INVALID_ARGUMENT with the reason.
+  std::shared_ptr<const OpenDriveRoads> roads;
+  try {
+    roads = std::make_shared<const OpenDriveRoads>(std::move(net));
+  } catch (const std::invalid_argument& e) {
+    require(e.what()[0] != '\0');
+    return 0;
+  }
   const RoadSurface surface(roads, 1);
   glm::dvec2 lo, hi;
   roads->bounds(lo, hi);
