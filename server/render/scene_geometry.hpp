@@ -4,8 +4,6 @@
 
 #include <vector>
 
-#include <glm/vec4.hpp>
-
 #include "server/render/mesh_data.hpp"
 #include "server/sim/road_network.hpp"
 

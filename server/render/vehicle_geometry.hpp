@@ -9,8 +9,6 @@
 
 namespace downpour::render {
 
-inline constexpr glm::dvec3 kDriverEye{1.05, 0.37, 1.22};
-
 // The windshield's corners in the vehicle frame, from the simulation's glass.
 struct WindshieldCorners {
   glm::vec3 bottom_right;
