@@ -15,7 +15,11 @@
 #include <grpcpp/health_check_service_interface.h>
 #include <spdlog/spdlog.h>
 
+#include "grpc_health/v1/health.pb.h"
+#include "server/app/log_format.hpp"
+#include "server/app/metrics.hpp"
 #include "server/app/server_config.hpp"
+#include "server/rpc/call_status.hpp"
 #include "server/rpc/downpour_service.hpp"
 #include "server/rpc/malformed_request.hpp"
 #include "server/session/frame_scheduler.hpp"
@@ -39,6 +43,32 @@ int next_signal(const sigset_t& signals, const timespec& wait) {
   return g_caught_signal.exchange(0);
 }
 
+// The server's state, into the metrics.
+void sample_metrics(downpour::app::Metrics& metrics, downpour::session::SessionRegistry& registry,
+                    const downpour::rpc::DownpourService& service,
+                    const downpour::session::FrameScheduler& scheduler, bool serving,
+                    double stalled_s) {
+  downpour::app::MetricsSample s;
+  for (const auto& session : registry.list()) {
+    if (session->config().mode == downpour::sim::Mode::kLockstep) {
+      ++s.sessions_lockstep;
+    } else {
+      ++s.sessions_realtime;
+    }
+  }
+  s.frames_dropped = service.frames_dropped();
+  s.frames_late = scheduler.stats().realtime_frames_late;
+  s.sessions_closed_idle = registry.closed_idle();
+  s.steps_in_flight = service.steps_in_flight();
+  s.open_streams = service.open_streams();
+  const downpour::session::SessionCost used = registry.cost_in_use();
+  s.pixel_rate_mpx_s = used.pixel_rate / 1e6;
+  s.memory_estimate_mib = used.memory_bytes / (1024.0 * 1024.0);
+  s.serving = serving;
+  s.render_loop_stalled_s = stalled_s;
+  metrics.update(s);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -47,6 +77,8 @@ int main(int argc, char** argv) {
   const auto config = app::parse_config(argc, argv, &exit_code);
   if (!config) return exit_code;
   spdlog::set_level(spdlog::level::from_str(config->log_level));
+  app::set_log_format(config->log_format);
+  spdlog::info("downpour-server {}", app::kVersion);
   // Security first: a server that would be exposed, or whose keys or tokens cannot be read, does
   // not start.
   if (const std::string problem = app::security_problem(*config); !problem.empty()) {
@@ -82,7 +114,19 @@ int main(int argc, char** argv) {
     if (scheduler_ptr) scheduler_ptr->wake();
   });
   registry.set_idle_timeout_s(config->session_idle_timeout_s);
+  // Metrics first: a port that cannot be had stops the server before the GL context is made.
+  std::shared_ptr<app::Metrics> metrics;
+  if (!config->metrics_listen.empty()) {
+    try {
+      metrics = std::make_shared<app::Metrics>(config->metrics_listen);
+    } catch (const std::exception& e) {
+      spdlog::critical("{} (--metrics-listen)", e.what());
+      return 1;
+    }
+    spdlog::info("metrics on http://{}/metrics (port {})", config->metrics_listen, metrics->port());
+  }
   session::SchedulerOptions options;
+  options.observer = metrics;
   options.renderer.platform = config->renderer;
   options.renderer.spray_smoothing = config->spray_smoothing;
   options.encoder_threads = config->encoder_threads;
@@ -96,6 +140,7 @@ int main(int argc, char** argv) {
   scheduler_ptr = &scheduler;
   const std::string renderer = scheduler.stats().renderer;
   spdlog::info("renderer: {}", renderer);
+  if (metrics) metrics->set_build_info(app::kVersion, renderer);
   const session::AdmissionBudget budget = app::admission_budget(*config, renderer);
   registry.set_budget(budget);
   spdlog::info("admission: {:.0f} Mpx/s, {:.0f} MiB of estimated session memory (0 = no limit)",
@@ -110,6 +155,8 @@ int main(int argc, char** argv) {
   auto road_networks = std::make_shared<rpc::RoadNetworks>(config->maps_dir, road_limits);
   if (!config->maps_dir.empty()) spdlog::info("maps from {}", config->maps_dir);
   rpc::DownpourService service(registry, scheduler, limits, auth, road_networks);
+  service.set_identity(app::kVersion, config->advertise);
+  if (!config->advertise.empty()) spdlog::info("advertising {} to clients", config->advertise);
 
   grpc::EnableDefaultHealthCheckService(true);
   // Probes that cannot speak TLS get the health service alone, in plaintext, on its own port.
@@ -129,14 +176,24 @@ int main(int argc, char** argv) {
     spdlog::info("health alone on {} (port {})", config->health_listen, health_port);
   }
   // Reflection describes the public schema (proto/) to tools such as grpcurl; the calls it
-  // describes still need their tokens.
+  // describes still need their tokens. gRPC's built-in health service carries no descriptor of
+  // its own (grpc/grpc#36665): naming our copy of health.proto's here links it into the binary,
+  // and so into the pool reflection reads.
+  grpc::health::v1::HealthCheckRequest::descriptor();
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
   int port = 0;
   builder.AddListeningPort(config->listen, credentials, &port);
   builder.RegisterService(&service);
   builder.SetMaxReceiveMessageSize(config->max_message_mb << 20);
-  builder.experimental().SetInterceptorCreators(rpc::malformed_request_interceptors());
+  auto interceptors = rpc::malformed_request_interceptors();
+  if (metrics) {  // after malformed_request's, so that it counts the status that goes out
+    interceptors.push_back(
+        rpc::call_status_interceptor([metrics](std::string_view method, grpc::StatusCode code) {
+          metrics->call_finished(method, code);
+        }));
+  }
+  builder.experimental().SetInterceptorCreators(std::move(interceptors));
   // Pings find a client whose host died with a stream open (no FIN ever comes): after 20 s of
   // silence a ping, and 10 s without its answer closes the connection, so the stream's lease on
   // its session ends and the idle timeout can take it.
@@ -184,6 +241,7 @@ int main(int argc, char** argv) {
     const Clock::time_point now = Clock::now();
     const double stalled = scheduler.stalled_s(now);
     const bool healthy = config->watchdog_s <= 0.0 || stalled < config->watchdog_s;
+    if (metrics) sample_metrics(*metrics, registry, service, scheduler, serving, stalled);
     if (healthy != serving) {
       serving = healthy;
       set_serving(serving);

@@ -14,6 +14,8 @@
 
 namespace downpour::app {
 
+const char* const kVersion = DOWNPOUR_VERSION;
+
 namespace {
 
 std::string read_file(const std::string& path, const char* what) {
@@ -84,7 +86,9 @@ session::AdmissionBudget admission_budget(const ServerConfig& config, const std:
 std::optional<ServerConfig> parse_config(int argc, char** argv, int* exit_code) {
   ServerConfig c;
   CLI::App app{"Downpour: renders rain for driving simulators and streams JPEG frames over gRPC."};
-  app.option_defaults()->always_capture_default();
+  // A flag given twice takes its last value (a wrapper script's defaults, then the caller's).
+  app.option_defaults()->always_capture_default()->multi_option_policy(
+      CLI::MultiOptionPolicy::TakeLast);
   app.add_option("--listen", c.listen, "address to listen on (host:port; port 0 picks a free one)")
       ->envname("DOWNPOUR_LISTEN");
   app.add_option("--port-file", c.port_file, "write the bound port to this file once serving");
@@ -107,25 +111,34 @@ std::optional<ServerConfig> parse_config(int argc, char** argv, int* exit_code) 
                  "llvmpipe rasterizer threads (LP_NUM_THREADS); 0 = as set")
       ->check(CLI::Range(0, 64))
       ->envname("DOWNPOUR_RENDER_THREADS");
+  // Named choices are read as text and mapped after parsing, so that --help lists the names.
   const std::map<std::string, render::EglPlatformChoice> renderers{
       {"auto", render::EglPlatformChoice::kAuto},
       {"device", render::EglPlatformChoice::kDevice},
       {"surfaceless", render::EglPlatformChoice::kSurfaceless}};
-  app.add_option("--renderer", c.renderer, "auto: a GPU's EGL device if any, else Mesa surfaceless")
-      ->transform(CLI::CheckedTransformer(renderers, CLI::ignore_case))
+  std::string renderer = "auto";
+  app.add_option("--renderer", renderer,
+                 "device: a GPU's EGL device; surfaceless: Mesa (llvmpipe on the CPU); auto: a "
+                 "device if there is one, else surfaceless")
+      ->check(CLI::IsMember({"auto", "device", "surfaceless"}, CLI::ignore_case))
       ->envname("DOWNPOUR_RENDERER");
   const std::map<std::string, render::SpraySmoothing> smoothings{
       {"plane_fit", render::SpraySmoothing::kPlaneFit},
       {"bilateral", render::SpraySmoothing::kBilateral},
       {"none", render::SpraySmoothing::kNone}};
-  app.add_option("--spray-smoothing", c.spray_smoothing,
-                 "the spray's liquid surface (seed 001): plane_fit (9x9, 3 passes), bilateral "
-                 "(7x7, 22 passes) or none")
-      ->transform(CLI::CheckedTransformer(smoothings, CLI::ignore_case))
+  std::string smoothing = "plane_fit";
+  app.add_option("--spray-smoothing", smoothing,
+                 "the spray's liquid surface: plane_fit (9x9, 3 passes), bilateral (7x7, 22 "
+                 "passes) or none")
+      ->check(CLI::IsMember({"plane_fit", "bilateral", "none"}, CLI::ignore_case))
       ->envname("DOWNPOUR_SPRAY_SMOOTHING");
   app.add_option("--log-level", c.log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->envname("DOWNPOUR_LOG_LEVEL");
+  app.add_option("--log-format", c.log_format,
+                 "text, or json: one object a line (time, level, session, msg)")
+      ->check(CLI::IsMember({"text", "json"}))
+      ->envname("DOWNPOUR_LOG_FORMAT");
   app.add_option("--stats-interval", c.stats_interval_s, "seconds between stats lines in the log")
       ->check(CLI::Range(1.0, 3600.0));
   app.add_option("--session-idle-timeout-s", c.session_idle_timeout_s,
@@ -184,12 +197,29 @@ std::optional<ServerConfig> parse_config(int argc, char** argv, int* exit_code) 
                  "the most road a session's network may have, km (every road's length added)")
       ->check(CLI::Range(0.1, 1000.0))
       ->envname("DOWNPOUR_MAX_ROAD_KM");
+  app.add_option("--metrics-listen", c.metrics_listen,
+                 "serve Prometheus metrics over HTTP at /metrics here (host:port); empty = none")
+      ->envname("DOWNPOUR_METRICS_LISTEN");
+  app.add_option("--advertise", c.advertise,
+                 "the address clients reach this server at (host:port), told in SessionInfo."
+                 "endpoint so that they follow a session to the server that holds it (several "
+                 "servers behind one name); empty = none")
+      ->envname("DOWNPOUR_ADVERTISE");
+  app.set_version_flag("--version", std::string("downpour-server ") + kVersion);
+  app.set_config("--config", "",
+                 "read flags from this file (TOML or INI: one `flag = value` a line, without "
+                 "the dashes); the command line wins over it")
+      ->envname("DOWNPOUR_CONFIG");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     *exit_code = app.exit(e);
     return std::nullopt;
   }
+  std::transform(renderer.begin(), renderer.end(), renderer.begin(), ::tolower);
+  std::transform(smoothing.begin(), smoothing.end(), smoothing.begin(), ::tolower);
+  c.renderer = renderers.at(renderer);
+  c.spray_smoothing = smoothings.at(smoothing);
   return c;
 }
 

@@ -14,6 +14,9 @@
 
 namespace downpour::app {
 
+// The server's version: the CMake project's (--version, GetStats, the metrics' build info).
+extern const char* const kVersion;
+
 struct ServerConfig {
   std::string listen = "127.0.0.1:50051";
   std::string port_file;  // written with the bound port once serving (tests use --listen ...:0)
@@ -26,6 +29,7 @@ struct ServerConfig {
   render::EglPlatformChoice renderer = render::EglPlatformChoice::kAuto;
   render::SpraySmoothing spray_smoothing = render::SpraySmoothing::kPlaneFit;
   std::string log_level = "info";
+  std::string log_format = "text";  // or "json" (app/log_format.hpp)
   double stats_interval_s = 30.0;
   // A session whose clients have all gone quiet (no request, no Drive stream) this long is
   // closed, so a crashed simulator does not hold a session slot forever; 0 = never.
@@ -57,6 +61,11 @@ struct ServerConfig {
   // time and memory its scene takes to build (on the CreateSession call's thread, not the render
   // loop's: about 40 ms and 3 MiB a km of six-lane road here).
   double max_road_km = 50.0;
+  // Prometheus metrics over HTTP (app/metrics.hpp), on this host:port; empty = none.
+  std::string metrics_listen;
+  // The address clients reach this server at, when several serve one name (SessionInfo.endpoint);
+  // empty = none.
+  std::string advertise;
 };
 
 // Parses argv; on --help or an error returns the exit code to use instead of a config.

@@ -528,6 +528,7 @@ grpc::ServerUnaryReactor* DownpourService::CreateSession(grpc::CallbackServerCon
   auto session = context_.registry.create(std::move(config), initial, &refusal);
   if (!session) return finish(ctx, grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, refusal));
   fill_session_info(*session, response);
+  response->set_endpoint(context_.endpoint);
   spdlog::info("session {} started: {} mode, {} view(s), seed {}, roads {}, by {} from {}",
                session->id(),
                session->config().mode == sim::Mode::kLockstep ? "lockstep" : "realtime",
@@ -560,8 +561,11 @@ grpc::ServerUnaryReactor* DownpourService::ListSessions(grpc::CallbackServerCont
   if (auto s = context_.auth.authenticate(*ctx, &who); !s.ok()) return finish(ctx, s);
   for (const auto& s : context_.registry.list()) {
     // A client sees its own sessions; a viewer (or an admin) sees all, to pick one to watch.
-    if (who.has(kViewer) || s->config().owner == who.name)
-      fill_session_info(*s, response->add_sessions());
+    if (who.has(kViewer) || s->config().owner == who.name) {
+      v1::SessionInfo* info = response->add_sessions();
+      fill_session_info(*s, info);
+      info->set_endpoint(context_.endpoint);
+    }
   }
   return finish(ctx, grpc::Status::OK);
 }
@@ -687,6 +691,8 @@ grpc::ServerUnaryReactor* DownpourService::GetStats(grpc::CallbackServerContext*
   if (auto s = context_.auth.authenticate(*ctx, &who); !s.ok()) return finish(ctx, s);
   const session::SchedulerStats s = scheduler_.stats();
   response->set_renderer(s.renderer);
+  response->set_version(context_.version);
+  response->set_endpoint(context_.endpoint);
   response->set_sessions(static_cast<std::uint32_t>(context_.registry.list().size()));
   response->set_frames_rendered(s.frames_rendered);
   response->set_frames_encoded(s.frames_encoded);

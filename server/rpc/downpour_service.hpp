@@ -3,6 +3,9 @@
 #pragma once
 
 #include <atomic>
+#include <cstdint>
+#include <string>
+#include <utility>
 
 #include "downpour/v1/downpour.grpc.pb.h"
 #include "server/rpc/auth.hpp"
@@ -56,6 +59,14 @@ class DownpourService final : public ServiceBase {
   int steps_in_flight() const { return context_.steps_in_flight.load(); }
   // Drive and WatchFrames streams not yet done (their final status not yet sent).
   int open_streams() const { return context_.open_streams.load(); }
+  // Frames that readers missed because they were slow (ServerStats.frames_dropped).
+  std::uint64_t frames_dropped() const { return context_.reader_drops.load(); }
+  // Before serving: the server's version (GetStats) and the address clients reach this server at
+  // (--advertise; SessionInfo.endpoint), empty if none.
+  void set_identity(std::string version, std::string endpoint) {
+    context_.version = std::move(version);
+    context_.endpoint = std::move(endpoint);
+  }
 
   // Everything the stream reactors need from the service.
   struct Context {
@@ -67,6 +78,8 @@ class DownpourService final : public ServiceBase {
     std::atomic<bool> draining{false};
     std::atomic<int> steps_in_flight{0};
     std::atomic<int> open_streams{0};
+    std::string version{};   // set before serving, read-only after
+    std::string endpoint{};  // likewise
   };
 
  private:

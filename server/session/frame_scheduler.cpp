@@ -416,6 +416,7 @@ void FrameScheduler::tick(const std::shared_ptr<Session>& s, const StartedStep& 
       f.client_time_s = inputs.client_time_s;
       f.inputs_arrived = inputs_arrived;
       ++frames_rendered_;
+      if (options_.observer) options_.observer->rendered(f.render_ms);
       std::lock_guard lock(stats_mutex_);
       record(render_ms_window_, render_ms_next_, f.render_ms);
       if (options_.profile_passes) pass_timings_ = renderer_->last_pass_timings();
@@ -499,6 +500,7 @@ void FrameScheduler::encode(InFlight f, std::vector<std::uint8_t> pixels, double
     frame->tires = f.tires;
     frame->ego_place = f.ego_place;
     ++frames_encoded_;
+    if (options_.observer) options_.observer->encoded(encode_ms, frame->stats.latency_ms);
     {
       std::lock_guard lock(stats_mutex_);
       record(encode_ms_window_, encode_ms_next_, encode_ms);

@@ -29,10 +29,21 @@
 
 namespace downpour::session {
 
+// Told of every view as it is rendered and as it is encoded (the server's metrics). Called on the
+// render thread and on the encoder threads: it must be cheap and thread-safe.
+class FrameObserver {
+ public:
+  virtual ~FrameObserver() = default;
+  virtual void rendered(double render_ms) = 0;
+  // latency_ms: from the tick that consumed the inputs to the encoded frame (FrameStats).
+  virtual void encoded(double encode_ms, double latency_ms) = 0;
+};
+
 struct SchedulerOptions {
   render::RendererOptions renderer;
   int encoder_threads = 1;
-  bool profile_passes = false;  // glFinish after each pass (benchmarks)
+  bool profile_passes = false;              // glFinish after each pass (benchmarks)
+  std::shared_ptr<FrameObserver> observer;  // may be null
 };
 
 struct SchedulerStats {
