@@ -208,19 +208,6 @@ TEST(SecurityTest, OnlyTheOwnerDrivesASessionAViewerWatchesAndAnAdminMayDoAll) {
   EXPECT_EQ(server.stop(15.0), 0);
 }
 
-// A port the kernel just handed out and took back (for --health-listen, which reports none).
-int free_port() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
-  socklen_t len = sizeof addr;
-  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
-  close(fd);
-  return ntohs(addr.sin_port);
-}
-
 std::string read(const std::string& path) {
   std::ifstream in(path);
   std::stringstream text;

@@ -16,6 +16,9 @@ namespace downpour::testing {
 // the sanitizer runs set it), for the tests' bounds on wall time.
 double time_scale();
 
+// A loopback port the kernel just handed out and took back (for a flag that needs one ahead).
+int free_port();
+
 class ServerProcess {
  public:
   explicit ServerProcess(std::vector<std::string> extra_args = {});

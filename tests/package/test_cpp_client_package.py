@@ -53,5 +53,20 @@ class CppClientPackageTest(ServerProcessCase):
                     self.assertEqual((image.format, image.size), ("JPEG", (320, 180)))
 
 
+    def test_the_server_installs_alone_with_its_systemd_unit(self):
+        with tempfile.TemporaryDirectory() as folder:
+            prefix = os.path.join(folder, "prefix")
+            for component in ("server", "systemd"):
+                run("cmake", "--install", BUILD, "--prefix", prefix, "--component", component)
+            server = os.path.join(prefix, "bin", "downpour-server")
+            self.assertRegex(run(server, "--version"), r"^downpour-server [0-9]+\.[0-9]+\.[0-9]+\n$")
+            with open(os.path.join(prefix, "lib", "systemd", "system", "downpour.service")) as unit:
+                text = unit.read()
+            self.assertIn(f"ExecStart={server} \\\n", text)
+            self.assertNotIn("@CMAKE", text)  # every placeholder filled
+            # The client's files are another component's.
+            self.assertFalse(os.path.exists(os.path.join(prefix, "include")))
+
+
 if __name__ == "__main__":
     unittest.main()

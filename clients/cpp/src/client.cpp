@@ -15,7 +15,9 @@ void check(const grpc::Status& status) {
 
 }  // namespace
 
-Client::Client(Options options) : options_(std::move(options)) {
+Client::Client(Options options) : options_(std::move(options)) { stub_ = connect(options_.target); }
+
+std::unique_ptr<v1::Downpour::Stub> Client::connect(const std::string& target) const {
   grpc::ChannelArguments args;
   args.SetMaxReceiveMessageSize(options_.max_message_mb << 20);
   std::shared_ptr<grpc::ChannelCredentials> credentials;
@@ -26,8 +28,16 @@ Client::Client(Options options) : options_(std::move(options)) {
     tls.pem_root_certs = options_.tls_ca_pem;
     credentials = grpc::SslCredentials(tls);
   }
-  channel_ = grpc::CreateCustomChannel(options_.target, credentials, args);
-  stub_ = v1::Downpour::NewStub(channel_);
+  return v1::Downpour::NewStub(grpc::CreateCustomChannel(target, credentials, args));
+}
+
+v1::Downpour::Stub& Client::stub_for(const std::string& session_id) {
+  std::lock_guard lock(mutex_);
+  const auto endpoint = endpoints_.find(session_id);
+  if (endpoint == endpoints_.end()) return *stub_;
+  std::unique_ptr<v1::Downpour::Stub>& stub = stubs_[endpoint->second];
+  if (!stub) stub = connect(endpoint->second);
+  return *stub;
 }
 
 void Client::prepare(grpc::ClientContext& context, bool with_timeout) const {
@@ -40,6 +50,10 @@ v1::SessionInfo Client::create_session(const v1::CreateSessionRequest& request) 
   prepare(context);
   v1::SessionInfo info;
   check(stub_->CreateSession(&context, request, &info));
+  if (!info.endpoint().empty() && info.endpoint() != options_.target) {
+    std::lock_guard lock(mutex_);
+    endpoints_[info.session_id()] = info.endpoint();
+  }
   return info;
 }
 
@@ -49,7 +63,12 @@ void Client::close_session(const std::string& session_id) {
   v1::CloseSessionRequest request;
   request.set_session_id(session_id);
   v1::CloseSessionResponse response;
-  check(stub_->CloseSession(&context, request, &response));
+  const grpc::Status status = stub_for(session_id).CloseSession(&context, request, &response);
+  {
+    std::lock_guard lock(mutex_);
+    endpoints_.erase(session_id);
+  }
+  check(status);
 }
 
 std::vector<v1::SessionInfo> Client::list_sessions() {
@@ -90,7 +109,7 @@ std::vector<v1::Frame> LockstepSession::step(double dt_s, const v1::Update& upda
   *request.mutable_update() = update;
   request.set_dt_s(dt_s);
   v1::StepResponse response;
-  check(client_.stub().Step(&context, request, &response));
+  check(client_.stub_for(info_.session_id()).Step(&context, request, &response));
   return {response.frames().begin(), response.frames().end()};
 }
 
@@ -103,7 +122,7 @@ RealtimeSession::RealtimeSession(Client& client, v1::CreateSessionRequest reques
   reader_ = std::thread([this, on_frame = std::move(on_frame)] {
     v1::WatchFramesRequest watch;
     watch.set_session_id(info_.session_id());
-    auto stream = client_.stub().WatchFrames(&watch_context_, watch);
+    auto stream = client_.stub_for(info_.session_id()).WatchFrames(&watch_context_, watch);
     v1::Frame frame;
     while (stream->Read(&frame)) {
       ++received_;
@@ -134,7 +153,7 @@ void RealtimeSession::update(const v1::Update& update) {
   request.set_session_id(info_.session_id());
   *request.mutable_update() = update;
   v1::UpdateResponse response;
-  check(client_.stub().Update(&context, request, &response));
+  check(client_.stub_for(info_.session_id()).Update(&context, request, &response));
 }
 
 }  // namespace downpour::client

@@ -12,7 +12,9 @@
 #include <atomic>
 #include <chrono>
 #include <functional>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -43,6 +45,9 @@ struct Options {
   int max_message_mb = 64;  // the largest response taken (four large views exceed gRPC's 4 MiB)
 };
 
+// Several servers may answer to one name (a headless Service): a session lives on the one that
+// created it, which names itself in SessionInfo.endpoint. The client sends every later call for a
+// session it created to that endpoint (same credentials), over a channel of its own.
 class Client {
  public:
   explicit Client(Options options = {});
@@ -52,14 +57,21 @@ class Client {
   std::vector<v1::SessionInfo> list_sessions();
   v1::ServerStats stats();
 
-  // For what this class does not wrap: the stub, and a context with the token and timeout.
+  // For what this class does not wrap: the stub of the target, the stub of the server that holds
+  // a session (the target unless its endpoint is another), and a context with the token and
+  // timeout. Thread-safe.
   v1::Downpour::Stub& stub() { return *stub_; }
+  v1::Downpour::Stub& stub_for(const std::string& session_id);
   void prepare(grpc::ClientContext& context, bool with_timeout = true) const;
 
  private:
+  std::unique_ptr<v1::Downpour::Stub> connect(const std::string& target) const;
+
   Options options_;
-  std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<v1::Downpour::Stub> stub_;
+  std::mutex mutex_;
+  std::map<std::string, std::string> endpoints_;  // session id -> endpoint, where not the target
+  std::map<std::string, std::unique_ptr<v1::Downpour::Stub>> stubs_;  // endpoint -> its stub
 };
 
 // A lockstep session: each step applies an update, advances dt_s and returns every view's frame.
