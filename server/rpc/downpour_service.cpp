@@ -207,7 +207,7 @@ class DriveReactor final : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc
 
   void on_frame(const FramePtr& frame) override {
     if (lockstep_) return;
-    slot_.put(frame);
+    if (slot_.put(frame).dropped) ++ctx_.reader_drops;  // a slow realtime reader's, too
     std::unique_lock lock(mutex_);
     advance(lock);
   }
