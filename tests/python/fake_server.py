@@ -30,6 +30,7 @@ class FakeDownpour(downpour_pb2_grpc.DownpourServicer):
         self.lock = threading.Lock()
         self.sessions = {}        # session id -> SessionInfo
         self.drive_requests = []  # every DriveRequest received, in order
+        self.updates = []         # every UpdateRequest received, in order
         self._next_id = 0
 
     def _tick(self, session_id, context):
@@ -63,6 +64,14 @@ class FakeDownpour(downpour_pb2_grpc.DownpourServicer):
     def ListSessions(self, request, context):
         with self.lock:
             return pb.ListSessionsResponse(sessions=self.sessions.values())
+
+    def Update(self, request, context):
+        with self.lock:
+            if request.session_id not in self.sessions:
+                context.abort(grpc.StatusCode.NOT_FOUND,
+                              f"session_id: unknown {request.session_id!r}")
+            self.updates.append(request)
+            return pb.UpdateResponse(sim_time_s=request.update.sim_time_s)
 
     def Step(self, request, context):
         return pb.StepResponse(frames=self._tick(request.session_id, context))
@@ -108,10 +117,11 @@ class FakeHealth(health_pb2_grpc.HealthServicer):
         return health_pb2.HealthCheckResponse(status=health_pb2.HealthCheckResponse.SERVING)
 
 
-def start():
-    """(grpc server, FakeDownpour, "127.0.0.1:port"); stop it with server.stop(0)."""
+def start(fake=None):
+    """(grpc server, FakeDownpour, "127.0.0.1:port"); stop it with server.stop(0). fake: the
+    servicer (a FakeDownpour of a subclass), a new FakeDownpour when None."""
     server = grpc.server(futures.ThreadPoolExecutor(max_workers=16))
-    fake = FakeDownpour()
+    fake = fake if fake is not None else FakeDownpour()
     downpour_pb2_grpc.add_DownpourServicer_to_server(fake, server)
     health_pb2_grpc.add_HealthServicer_to_server(FakeHealth(), server)
     port = server.add_insecure_port("127.0.0.1:0")

@@ -1,7 +1,9 @@
 """DownpourClient: a thin wrapper over the generated Downpour stub."""
 
 import collections
+import itertools
 import os
+import threading
 import time
 
 import grpc
@@ -10,6 +12,8 @@ from downpour.v1 import downpour_pb2_grpc
 from grpc_health.v1 import health_pb2, health_pb2_grpc
 
 from .messages import mode_value, to_view_spec, view_value
+# Re-exported: they lived here before.
+from .security import add_security_arguments, security_options  # noqa: F401
 
 # Four views at the largest size can exceed gRPC's default limit of 4 MiB per message.
 _MAX_MESSAGE_BYTES = 64 * 1024 * 1024
@@ -51,23 +55,9 @@ def _read(path):
         return file.read()
 
 
-def add_security_arguments(parser):
-    """The command-line options of a protected server (README, Exposing the server)."""
-    parser.add_argument("--token", help="bearer token (default: $DOWNPOUR_TOKEN)")
-    parser.add_argument("--tls-ca", help="CA certificate (PEM) of a TLS server "
-                                         "(default: $DOWNPOUR_TLS_CA)")
-    parser.add_argument("--tls-cert", help="this client's certificate (PEM), for mutual TLS")
-    parser.add_argument("--tls-key", help="this client's private key (PEM), for mutual TLS")
-
-
-def security_options(args):
-    """DownpourClient keyword arguments from add_security_arguments' options."""
-    return {"token": args.token, "tls_ca": args.tls_ca, "tls_cert": args.tls_cert,
-            "tls_key": args.tls_key}
-
-
 class DownpourClient:
-    """One channel to one server. Use as a context manager to close the channel.
+    """One channel to one server, and one more per replica that holds a session of ours. Use as a
+    context manager to close the channels.
 
     token: the bearer token a server with a tokens file wants (default: $DOWNPOUR_TOKEN).
     tls_ca: PEM file of the CA that signed the server's certificate: connect with TLS (default:
@@ -75,16 +65,22 @@ class DownpourClient:
     stream_window_kib: the most frame data gRPC takes in ahead of the reader, per stream. A
     reader that pauses finds at most this much of old frames waiting before the latest, instead of
     the megabytes a window grown by gRPC's bandwidth probe holds (README, Frames and flow
-    control). 0 keeps gRPC's own (faster over long, fast links).
+    control). 0 keeps gRPC's own (faster over long, fast links). channel_options: more gRPC
+    channel arguments, (name, value) pairs (e.g. ("grpc.lb_policy_name", "round_robin")).
+
+    Scale-out: a server started with --advertise names itself in SessionInfo.endpoint, and every
+    later call naming the session must go there. The client remembers the endpoint of each session
+    it creates (or is told of with remember()) and sends close_session, update, step, drive and
+    watch_frames for it over a channel of their own to that endpoint, with the same credentials.
     """
 
     def __init__(self, target="127.0.0.1:50051", timeout_s=30.0, token=None, tls_ca=None,
-                 tls_cert=None, tls_key=None, stream_window_kib=256):
+                 tls_cert=None, tls_key=None, stream_window_kib=256, channel_options=()):
         self.target = target
         self.timeout_s = timeout_s  # deadline of each unary call
-        token = token if token is not None else os.environ.get("DOWNPOUR_TOKEN")
+        self._token = token if token is not None else os.environ.get("DOWNPOUR_TOKEN")
         tls_ca = tls_ca if tls_ca is not None else os.environ.get("DOWNPOUR_TLS_CA")
-        options = [
+        self._options = [
             ("grpc.max_receive_message_length", _MAX_MESSAGE_BYTES),
             ("grpc.max_send_message_length", _MAX_MESSAGE_BYTES),
             # Reconnect within a second of a server (re)start instead of backing off for minutes.
@@ -92,22 +88,37 @@ class DownpourClient:
             ("grpc.max_reconnect_backoff_ms", 1000),
         ]
         if stream_window_kib:
-            options += [("grpc.http2.bdp_probe", 0),
-                        ("grpc.http2.lookahead_bytes", int(stream_window_kib) * 1024)]
+            self._options += [("grpc.http2.bdp_probe", 0),
+                              ("grpc.http2.lookahead_bytes", int(stream_window_kib) * 1024)]
+        self._options += list(channel_options)
+        self._credentials = None
         if tls_ca:
-            credentials = grpc.ssl_channel_credentials(
+            self._credentials = grpc.ssl_channel_credentials(
                 root_certificates=_read(tls_ca),
                 private_key=_read(tls_key) if tls_key else None,
                 certificate_chain=_read(tls_cert) if tls_cert else None)
-            self._channel = grpc.secure_channel(target, credentials, options=options)
-        else:
-            self._channel = grpc.insecure_channel(target, options=options)
-        if token:
-            self._channel = grpc.intercept_channel(self._channel, _BearerToken(token))
+        self._lock = threading.Lock()
+        self._endpoints = {}  # session id -> the endpoint that holds it, when not self.target
+        self._stubs = {}      # endpoint -> (channel, stub), made on first use
+        self._channel = self._open_channel(target)
         self.stub = downpour_pb2_grpc.DownpourStub(self._channel)
         self._health = health_pb2_grpc.HealthStub(self._channel)
 
+    def _open_channel(self, target):
+        if self._credentials is not None:
+            channel = grpc.secure_channel(target, self._credentials, options=self._options)
+        else:
+            channel = grpc.insecure_channel(target, options=self._options)
+        if self._token:
+            channel = grpc.intercept_channel(channel, _BearerToken(self._token))
+        return channel
+
     def close(self):
+        with self._lock:
+            others = [channel for channel, _ in self._stubs.values()]
+            self._stubs.clear()
+        for channel in others:
+            channel.close()
         self._channel.close()
 
     def __enter__(self):
@@ -115,6 +126,39 @@ class DownpourClient:
 
     def __exit__(self, *exc_info):
         self.close()
+
+    def remember(self, session, endpoint=None):
+        """Routes later calls naming a session to the server that holds it. session: a
+        SessionInfo (its endpoint is used) or a session id with endpoint. An empty endpoint, or
+        this client's own target, routes it here."""
+        if not isinstance(session, str):
+            session, endpoint = session.session_id, getattr(session, "endpoint", "")
+        with self._lock:
+            if endpoint and endpoint != self.target:
+                self._endpoints[session] = endpoint
+            else:
+                self._endpoints.pop(session, None)
+
+    def forget(self, session_id):
+        with self._lock:
+            self._endpoints.pop(session_id, None)
+
+    def endpoint_of(self, session_id):
+        """The target that calls naming session_id go to."""
+        with self._lock:
+            return self._endpoints.get(session_id, self.target)
+
+    def stub_for(self, session_id):
+        """The Downpour stub that reaches the server holding session_id."""
+        with self._lock:
+            endpoint = self._endpoints.get(session_id)
+            if endpoint is None:
+                return self.stub
+            entry = self._stubs.get(endpoint)
+            if entry is None:
+                channel = self._open_channel(endpoint)
+                entry = self._stubs[endpoint] = (channel, downpour_pb2_grpc.DownpourStub(channel))
+            return entry[1]
 
     def create_session(self, views, mode="LOCKSTEP", fps=0.0, seed=0, initial=None, roads=None,
                        ego=None):
@@ -134,20 +178,34 @@ class DownpourClient:
         return self.create_session_from(request)
 
     def create_session_from(self, request):
-        return self.stub.CreateSession(request, timeout=self.timeout_s)
+        """CreateSession -> SessionInfo; later calls naming the session go to its endpoint."""
+        info = self.stub.CreateSession(request, timeout=self.timeout_s)
+        self.remember(info)
+        return info
 
     def close_session(self, session_id):
-        self.stub.CloseSession(pb.CloseSessionRequest(session_id=session_id),
-                               timeout=self.timeout_s)
+        self.stub_for(session_id).CloseSession(pb.CloseSessionRequest(session_id=session_id),
+                                               timeout=self.timeout_s)
+        self.forget(session_id)
 
     def list_sessions(self):
+        """The sessions of the server at this client's target (not those of other replicas)."""
         return list(self.stub.ListSessions(pb.ListSessionsRequest(),
                                            timeout=self.timeout_s).sessions)
 
+    def find_session(self, session_id):
+        """The SessionInfo of session_id from list_sessions(), remembered for routing; None when
+        the server at this client's target does not list it."""
+        for info in self.list_sessions():
+            if info.session_id == session_id:
+                self.remember(info)
+                return info
+        return None
+
     def update(self, session_id, update):
         """Applies a partial Update; returns the session's sim time when it was accepted."""
-        response = self.stub.Update(pb.UpdateRequest(session_id=session_id, update=update),
-                                    timeout=self.timeout_s)
+        request = pb.UpdateRequest(session_id=session_id, update=update)
+        response = self.stub_for(session_id).Update(request, timeout=self.timeout_s)
         return response.sim_time_s
 
     def step(self, session_id, dt_s, update=None):
@@ -155,17 +213,27 @@ class DownpourClient:
         request = pb.StepRequest(session_id=session_id, dt_s=dt_s)
         if update is not None:
             request.update.CopyFrom(update)
-        return list(self.stub.Step(request, timeout=self.timeout_s).frames)
+        return list(self.stub_for(session_id).Step(request, timeout=self.timeout_s).frames)
 
-    def drive(self, requests, timeout_s=None):
-        """Streams DriveRequests; returns the call: iterate for DriveResponses, cancel() to end."""
-        return self.stub.Drive(iter(requests), timeout=timeout_s)
+    def drive(self, requests, timeout_s=None, session_id=None):
+        """Streams DriveRequests; returns the call: iterate for DriveResponses, cancel() to end.
+        session_id: the session driven, for routing; None takes the first request's, read here
+        before the call starts when some session of this client lives elsewhere."""
+        requests = iter(requests)
+        with self._lock:
+            routed = bool(self._endpoints)
+        if session_id is None and routed:
+            first = next(requests, None)
+            if first is not None:
+                session_id = first.session_id
+                requests = itertools.chain([first], requests)
+        return self.stub_for(session_id or "").Drive(requests, timeout=timeout_s)
 
     def watch_frames(self, session_id, views=(), max_fps=0.0, timeout_s=None):
         """Returns the call, an iterator of Frames (cancel() ends it); no views = every view."""
         request = pb.WatchFramesRequest(
             session_id=session_id, views=[view_value(v) for v in views], max_fps=max_fps)
-        return self.stub.WatchFrames(request, timeout=timeout_s)
+        return self.stub_for(session_id).WatchFrames(request, timeout=timeout_s)
 
     def get_stats(self):
         return self.stub.GetStats(pb.GetStatsRequest(), timeout=self.timeout_s)

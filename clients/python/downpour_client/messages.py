@@ -1,6 +1,7 @@
 """Small helpers that build downpour.v1 messages from plain Python values."""
 
 from downpour.v1 import downpour_pb2 as pb
+from google.protobuf import json_format
 
 _PREFIXES = {"View": "VIEW_", "Mode": "MODE_", "WiperMode": "WIPER_"}
 
@@ -90,3 +91,14 @@ def to_view_spec(value):
                          aperture_mm=value.get("aperture_mm"),
                          exposure_s=value.get("exposure_s"))
     return view_spec(*value)
+
+
+def message_dict(message):
+    """A message as a dict by proto3's JSON mapping: the .proto's field names, fields at their
+    default value included."""
+    try:
+        return json_format.MessageToDict(message, preserving_proto_field_name=True,
+                                         including_default_value_fields=True)
+    except TypeError:  # protobuf 5.26 renamed the option
+        return json_format.MessageToDict(message, preserving_proto_field_name=True,
+                                         always_print_fields_with_no_presence=True)
