@@ -21,6 +21,7 @@ PACKAGES=(cmake ninja-build g++ pkg-config
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   libgtest-dev libgmock-dev libbenchmark-dev glslang-tools prometheus-cpp-dev
   python3 python3-grpcio python3-protobuf python3-pil openssl
+  python3-venv python3-pip python3-setuptools python3-wheel ffmpeg chromium
   sumo sumo-tools)
 FUZZ_PACKAGES=(clang-14 libclang-rt-14-dev)
 
@@ -39,8 +40,23 @@ install_packages() {
 
 build() {
   install_packages
+  web_packages
   cmake -S "$ROOT" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
   cmake --build "$BUILD" -j "$(nproc)"
+}
+
+# The viewer's plots (uPlot) and the browser test's driver (puppeteer-core), from the npm registry
+# at the versions their lock files name; again only when a lock file changed.
+web_packages() {
+  command -v npm >/dev/null || install_packages nodejs npm
+  local dir
+  for dir in clients/viewer tests/viewer; do
+    if [ ! -f "$ROOT/$dir/node_modules/.package-lock.json" ] ||
+      [ "$ROOT/$dir/package-lock.json" -nt "$ROOT/$dir/node_modules/.package-lock.json" ]; then
+      echo "npm ci in $dir"
+      npm ci --prefix "$ROOT/$dir" --no-audit --no-fund --loglevel=error
+    fi
+  done
 }
 
 # Software GL: one rasterizer thread per core unless the caller chose.
@@ -69,13 +85,16 @@ demo() {
     --server "$target" --mode realtime >"$dir/drive.log" 2>&1 &
   pids+=($!)
   PYTHONPATH="$ROOT/clients/python" DOWNPOUR_PYTHON_STUBS="$BUILD/python" \
-    "$PY" "$ROOT/clients/viewer/viewer.py" --server "$target" --port "${DOWNPOUR_VIEWER_PORT:-8080}" \
+    "$PY" "$ROOT/clients/viewer/viewer.py" --server "$target" --host "${DOWNPOUR_VIEWER_HOST:-127.0.0.1}" \
+    --port "${DOWNPOUR_VIEWER_PORT:-8080}" \
     >"$dir/viewer.log" 2>&1 &
   pids+=($!)
   echo
   echo "Downpour demo running: server on $target ($(grep -o 'renderer: .*' "$dir/server.log" || true))"
   echo "  drive:  highway_heavy_rain, realtime (log: $dir/drive.log)"
-  echo "  viewer: http://127.0.0.1:${DOWNPOUR_VIEWER_PORT:-8080}/   (Ctrl-C stops everything)"
+  echo "  viewer: http://127.0.0.1:${DOWNPOUR_VIEWER_PORT:-8080}/        the control room: sessions, views, stats, plots"
+  echo "          http://127.0.0.1:${DOWNPOUR_VIEWER_PORT:-8080}/drive   drive it yourself (keys, wipers, weather)"
+  echo "  (Ctrl-C stops everything)"
   wait -n "${pids[@]}" || true
   echo "a demo process ended; see the logs in $dir"
 }

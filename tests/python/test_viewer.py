@@ -70,7 +70,13 @@ class ViewerTest(unittest.TestCase):
 
         code, content_type, page = self.get("/")
         self.assertEqual((code, content_type), (200, "text/html; charset=utf-8"))
-        self.assertIn(b"/stream/", page)
+        self.assertIn(b"Downpour</span> control room", page)
+        self.assertIn(b"/static/app.js", page)
+        self.assertEqual(self.get("/static/app.js")[:2],
+                         (200, "application/javascript; charset=utf-8"))
+        self.assertEqual(self.get("/drive")[0], 200)
+        self.assertEqual(self.get("/static/../viewer.py")[0], 404)
+        self.assertEqual(self.get("/vendor/../viewer.py")[0], 404)
         code, content_type, still = self.get("/frame/rain.jpg")
         self.assertEqual((code, content_type), (200, "image/jpeg"))
         self.assertEqual(Image.open(io.BytesIO(still)).size, (32, 16))
@@ -105,11 +111,161 @@ class ViewerTest(unittest.TestCase):
         status = self.wait_for(lambda s: s["session_id"] == second and s["views"])
         self.assertEqual(status["state"], "watching")
 
+    def post(self, path, body):
+        connection = http.client.HTTPConnection("127.0.0.1", self.port, timeout=10)
+        connection.request("POST", path, json.dumps(body),
+                           {"Content-Type": "application/json"})
+        response = connection.getresponse()
+        return response.status, json.loads(response.read())
+
+    def test_frame_stats_history_and_session_list(self):
+        session_id = self.create_session()
+        status = self.wait_for(lambda s: len(s["views"]) == 2 and s["sessions"])
+        self.assertEqual(status["server"]["state"], "up")
+        listed = status["sessions"][0]
+        self.assertEqual((listed["session_id"], listed["mode"], listed["fps"]),
+                         (session_id, "realtime", 20.0))
+        self.assertEqual([v["view"] for v in listed["views"]], ["cockpit", "rain"])
+        self.assertFalse(listed["late"])
+        self.assertIn("glass_wet_fraction", status["views"][0]["stats"])
+
+        connection = http.client.HTTPConnection("127.0.0.1", self.port, timeout=10)
+        connection.request("GET", "/api/frame/cockpit.json")
+        response = connection.getresponse()
+        info = json.loads(response.read())
+        self.assertEqual(response.status, 200)
+        self.assertEqual((info["view"], info["width"], info["height"]), ("cockpit", 64, 48))
+        for key in ("frame_number", "sim_time_s", "render_ms", "encode_ms", "latency_ms",
+                    "view_wet_fraction", "road_states", "fps"):
+            self.assertIn(key, info)
+        self.assertEqual(self.get("/api/frame/road.json")[0], 404)
+
+        # The page's frame loop: ?after=N answers with a newer frame.
+        connection.request("GET", f"/frame/cockpit.jpg?after={info['frame_number']}")
+        response = connection.getresponse()
+        response.read()
+        self.assertEqual(response.status, 200)
+        self.assertGreater(int(response.getheader("X-Frame-Number")), info["frame_number"])
+
+        time.sleep(0.6)
+        history = json.loads(self.get("/api/history.json")[2])
+        self.assertEqual(history["session_id"], session_id)
+        self.assertGreaterEqual(len(history["views"]["cockpit"]["t"]), 2)
+        self.assertEqual(set(history["views"]["cockpit"]),
+                         {"t", "fps", "session_fps", "latency_ms", "render_ms", "encode_ms",
+                          "glass_wet", "view_wet", "road_wet"})
+
+        # Picking a session follows it.
+        second = self.create_session()
+        self.assertEqual(self.post("/api/follow", {"session_id": second})[0], 200)
+        status = self.wait_for(lambda s: s["session_id"] == second and s["views"])
+        self.assertEqual(status["selected"], second)
+
+    def test_drive_it_yourself(self):
+        code, drive = self.post("/api/drive/start", {"width": 96, "height": 54, "fps": 20})
+        self.assertEqual((code, drive["state"]), (200, "driving"))
+        session_id = drive["session_id"]
+        info = self.fake.sessions[session_id]
+        self.assertEqual(info.mode, pb.MODE_REALTIME)
+        self.assertEqual([(v.view, v.width) for v in info.views],
+                         [(pb.VIEW_COCKPIT, 96), (pb.VIEW_ROAD, 96)])
+        self.wait_for(lambda s: s["session_id"] == session_id and s["views"])
+
+        deadline = time.monotonic() + 2.0
+        while time.monotonic() < deadline:  # the page repeats the held keys
+            self.post("/api/drive/controls", {"throttle": True})
+            time.sleep(0.2)
+        code, drive = self.post("/api/drive/controls", {
+            "throttle": False, "wipers": "high", "weather": {"rain_rate_mm_h": 75}})
+        self.assertEqual(code, 200)
+        self.assertGreater(drive["speed_mps"], 3.0)
+        self.assertEqual(self.post("/api/drive/controls", {"wipers": "sideways"})[0], 400)
+        self.assertEqual(self.post("/api/drive/controls", {"weather": {"hail": 1}})[0], 400)
+        time.sleep(0.3)
+        drive = json.loads(self.get("/api/drive/state.json")[2])
+        self.assertEqual(drive["wipers_in_effect"], "high")
+        self.assertEqual(drive["weather_in_effect"]["rain_rate_mm_h"], 75.0)
+
+        updates = [u.update for u in list(self.fake.updates) if u.session_id == session_id]
+        self.assertGreater(len(updates), 30)  # about 20 a second
+        speeds = [u.vehicle.velocity_mps.x for u in updates]
+        self.assertGreater(max(speeds), 3.0)
+        self.assertTrue(all(u.HasField("vehicle") for u in updates))
+        self.assertEqual([u.wipers.mode for u in updates if u.HasField("wipers")],
+                         [pb.WIPER_HIGH])
+        self.assertEqual([u.weather.rain_rate_mm_h for u in updates if u.HasField("weather")],
+                         [75.0])
+        # Along the track's first straight, in the outer lane.
+        last = updates[-1].vehicle
+        self.assertGreater(last.position_m.x, 20.0)
+        self.assertAlmostEqual(last.position_m.y, -5.25, places=3)
+        self.assertAlmostEqual(last.rotation.yaw_deg, 0.0, places=3)
+
+        code, drive = self.post("/api/drive/stop", {})
+        self.assertEqual((code, drive["state"]), (200, "ended"))
+        self.assertNotIn(session_id, self.fake.sessions)
+
+    def test_drive_session_closed_when_the_viewer_exits(self):
+        session_id = self.post("/api/drive/start", {})[1]["session_id"]
+        self.assertIn(session_id, self.fake.sessions)
+        self.viewer.send_signal(signal.SIGTERM)
+        self.assertEqual(self.viewer.wait(timeout=10), 0)
+        self.assertNotIn(session_id, self.fake.sessions)
+
+    def test_server_down_is_one_clean_line(self):
+        self.server.stop(0).wait()
+        status = self.wait_for(lambda s: s["server"]["state"] == "down")
+        self.assertIn("unreachable", status["server"]["error"])
+        time.sleep(2.5)  # a few retries
+        self.viewer.send_signal(signal.SIGINT)
+        self.viewer.wait(timeout=10)
+        stderr = self.viewer.stderr.read()
+        self.assertNotIn("Traceback", stderr)
+        self.assertEqual(stderr.count("unreachable"), 1, stderr)
+        self.assertEqual(len(stderr.strip().splitlines()), 1, stderr)
+
     def test_interrupt_stops_the_viewer(self):
         self.create_session()
         self.wait_for(lambda s: s["views"])
         self.viewer.send_signal(signal.SIGINT)
         self.assertEqual(self.viewer.wait(timeout=10), 0)
+
+
+class TrackTest(unittest.TestCase):
+    """The viewer's copy of the built-in track (server/sim/track.cpp) and its car."""
+
+    @classmethod
+    def setUpClass(cls):
+        import importlib.util
+        spec = importlib.util.spec_from_file_location("downpour_viewer", VIEWER)
+        cls.viewer = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(cls.viewer)
+
+    def test_track_geometry(self):
+        track = self.viewer.Track()
+        self.assertAlmostEqual(track.length, 2 * 900 + 2 * 3.141592653589793 * 250, places=6)
+        x, y, z, heading, curvature, _ = track.at(900 + 3.141592653589793 * 250)
+        self.assertAlmostEqual(x, 900, places=6)
+        self.assertAlmostEqual(y, 500, places=6)
+        self.assertAlmostEqual(heading, 3.141592653589793, places=6)
+        self.assertEqual(curvature, 0.0)
+        self.assertAlmostEqual(track.at(2 * 900 + 3.141592653589793 * 250 - 450)[2], 10.0)
+        self.assertAlmostEqual(track.at(track.length + 5)[0], 5.0)
+
+    def test_the_car_keeps_its_lane_through_the_curve_and_steers(self):
+        car = self.viewer.Car(self.viewer.Track(), s=850.0, lateral=-5.25)
+        car.speed = 20.0
+        for _ in range(20 * 45):  # 45 s at 20 Hz, cruising, no keys: round the first curve
+            car.step(0.05, False, False, 0.0)
+            car.speed = 20.0
+        self.assertGreater(car.s, 900 + 3.141592653589793 * 250)
+        self.assertAlmostEqual(car.lateral, -5.25, delta=0.3)
+        for _ in range(20):  # one second of left steering
+            car.step(0.05, False, False, 1.0)
+        self.assertGreater(car.lateral, -5.0)
+        for _ in range(200):  # and a long hold stops at the road's edge
+            car.step(0.05, False, False, 1.0)
+        self.assertLessEqual(car.lateral, self.viewer.Track.PAVED_HALF_WIDTH)
 
 
 if __name__ == "__main__":
