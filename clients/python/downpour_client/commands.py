@@ -177,6 +177,17 @@ def ignore_signals():
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
 
 
+def _play_then_close(client, player, session_id):
+    """Runs the player until its end, a signal or Ctrl-C, then closes the session."""
+    _on_signals(player.stop)
+    try:
+        player.run()
+    except KeyboardInterrupt:
+        player.stop()
+    finally:
+        _close_quietly(client, session_id)
+
+
 def _close_quietly(client, session_id):
     """Closes a session of ours at the end of a command; a failure is a warning."""
     ignore_signals()  # a second Ctrl-C must not skip closing the session
@@ -204,13 +215,9 @@ def play(args):
         print(f"session_id={info.session_id}", flush=True)
         player = Player(client, scenario, info.session_id, args.mode, args.out, args.frames,
                         args.duration)
-        _on_signals(player.stop)
         try:
-            player.run()
-        except KeyboardInterrupt:
-            player.stop()
+            _play_then_close(client, player, info.session_id)
         finally:
-            _close_quietly(client, info.session_id)
             print(player.summary(), flush=True)
     return 0
 
@@ -484,13 +491,7 @@ def record(args):
                 player = Player(client, scenario, info.session_id, "lockstep",
                                 frames=args.frames, duration_s=args.duration,
                                 on_frames=on_frames)
-                _on_signals(player.stop)
-                try:
-                    player.run()
-                except KeyboardInterrupt:
-                    player.stop()
-                finally:
-                    _close_quietly(client, info.session_id)
+                _play_then_close(client, player, info.session_id)
             finished = True
         finally:
             try:
