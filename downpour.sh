@@ -54,7 +54,9 @@ web_packages() {
     if [ ! -f "$ROOT/$dir/node_modules/.package-lock.json" ] ||
       [ "$ROOT/$dir/package-lock.json" -nt "$ROOT/$dir/node_modules/.package-lock.json" ]; then
       echo "npm ci in $dir"
-      npm ci --prefix "$ROOT/$dir" --no-audit --no-fund --loglevel=error
+      # Without the registry the viewer still runs (no plots) and the browser test skips.
+      npm ci --prefix "$ROOT/$dir" --no-audit --no-fund --loglevel=error ||
+        echo "warning: npm ci in $dir failed; going on without it"
     fi
   done
 }
@@ -131,7 +133,7 @@ tsan() {
   cmake --build "$dir" -j "$(nproc)" --target downpour-server downpour_unit_tests
   export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$ROOT/tests/tsan.supp"
   "$dir/tests/downpour_unit_tests" \
-    --gtest_filter='Session*:LatestFrameSlot*:TickPolicy*:JpegEncoder*:EncoderPool*'
+    --gtest_filter='Session*:LatestFrameSlot*:TickPolicy*:JpegEncoder*:EncoderPool*:Metrics*'
   EGL_PLATFORM=surfaceless LP_NUM_THREADS=2 DOWNPOUR_SERVER="$dir/downpour-server" \
     DOWNPOUR_TEST_TIME_SCALE=3 "$BUILD/tests/downpour_integration_tests"
 }

@@ -46,6 +46,7 @@ from downpour_client import (  # noqa: E402
 from downpour.v1 import downpour_pb2 as pb  # noqa: E402
 
 MIN_RATE_SPAN_S = 0.5
+MAX_BODY_BYTES = 64 * 1024  # a POST's JSON body
 FPS_WINDOW_S = 2.0
 RETRY_S = 0.5
 LIST_PERIOD_S = 1.0
@@ -59,6 +60,13 @@ VENDOR_FILES = {"uPlot.iife.min.js": "application/javascript; charset=utf-8",
                 "uPlot.min.css": "text/css; charset=utf-8"}
 STATIC_TYPES = {".html": "text/html; charset=utf-8", ".js": "application/javascript; charset=utf-8",
                 ".css": "text/css; charset=utf-8", ".svg": "image/svg+xml"}
+
+
+def _finite(value, name):
+    """A JSON number from a page, as a float; ValueError (a 400) for anything else."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ValueError(f"{name}: a number is needed")
+    return float(value)
 
 
 def log(message):
@@ -418,6 +426,8 @@ class Follower(threading.Thread):
             if self._stopping.is_set():
                 return
             self._call = self.client.watch_frames(session_id, max_fps=self.max_fps)
+            if self._wake.is_set():  # picked another while this one was being chosen
+                self._call.cancel()
         self.frames.follow(session_id)
         self.once_log("follow", f"following session {session_id}")
         try:
@@ -622,15 +632,16 @@ class DriveController:
         self.server_sim_time_s = 0.0
 
     def start(self, width=480, height=270, fps=20.0):
+        # Checked before anything changes: a bad request leaves the drive as it was.
+        width = int(max(64, min(1920, _finite(width, "width"))))
+        height = int(max(64, min(1080, _finite(height, "height"))))
+        fps = float(max(1.0, min(60.0, _finite(fps, "fps"))))
         with self._lock:
             if self.state in ("starting", "driving"):
                 self.heard = time.monotonic()
                 return self._state_locked()
             self._reset()
             self.state = "starting"
-        width = int(max(64, min(1920, width)))
-        height = int(max(64, min(1080, height)))
-        fps = float(max(1.0, min(60.0, fps)))
         initial = pb.Update(sim_time_s=0.0)
         initial.vehicle.CopyFrom(self.car.vehicle_state())
         initial.weather.CopyFrom(pb.Weather(**self.weather))
@@ -755,6 +766,8 @@ class DriveController:
             except grpc.RpcError as error:
                 message = describe_error(error, session_id)
                 with self._lock:
+                    if stop.is_set() or self.session_id != session_id:
+                        return  # a late answer for a drive already stopped: not the new one's
                     if weather is not None:
                         self.pending_weather = True
                     if wipers is not None:
@@ -768,6 +781,8 @@ class DriveController:
                 stop.wait(RETRY_S)
                 continue
             with self._lock:
+                if stop.is_set() or self.session_id != session_id:
+                    return
                 self.updates_sent += 1
                 self.server_sim_time_s = server_time
                 self.error = ""
@@ -802,7 +817,27 @@ class ViewerHandler(BaseHTTPRequestHandler):
     follower = None   # Follower or None
     drive = None      # DriveController or None
 
+    def _host_allowed(self):
+        """Bound to loopback, the page answers only to loopback names, so that a web page whose
+        name was made to resolve to 127.0.0.1 (DNS rebinding) cannot read or drive it."""
+        if not self.loopback_only:
+            return True
+        host = (self.headers.get("Host") or "").rsplit(":", 1)[0].strip("[]").lower()
+        return host in ("localhost", "127.0.0.1", "::1", "")
+
+    def _same_origin(self):
+        """A POST changes what the viewer does with its token: only the viewer's own pages may
+        send one (a browser names the page's origin; other clients, such as tests, send none)."""
+        site = self.headers.get("Sec-Fetch-Site")
+        if site is not None:
+            return site == "same-origin"
+        origin = self.headers.get("Origin")
+        return origin is None or origin == f"http://{self.headers.get('Host', '')}"
+
     def do_GET(self):
+        if not self._host_allowed():
+            self._send(HTTPStatus.FORBIDDEN, "text/plain", b"unknown host name\n")
+            return
         path, _, query = self.path.partition("?")
         params = dict(p.partition("=")[::2] for p in query.split("&") if p)
         if path in ("/", "/index.html"):
@@ -838,8 +873,14 @@ class ViewerHandler(BaseHTTPRequestHandler):
 
     def do_POST(self):
         path = self.path.split("?", 1)[0]
+        if not self._host_allowed() or not self._same_origin():
+            self._send(HTTPStatus.FORBIDDEN, "text/plain", b"not from this viewer's pages\n")
+            return
         try:
             length = int(self.headers.get("Content-Length") or 0)
+            if not 0 <= length <= MAX_BODY_BYTES:
+                self.close_connection = True
+                raise ValueError(f"the body must be 0 to {MAX_BODY_BYTES} bytes")
             raw = self.rfile.read(length) if length else b""
             body = json.loads(raw) if raw.strip() else {}
             if not isinstance(body, dict):
@@ -858,7 +899,7 @@ class ViewerHandler(BaseHTTPRequestHandler):
                 self._json(self.drive.stop(str(body.get("reason") or "stopped on the page")))
             else:
                 self._send(HTTPStatus.NOT_FOUND, "text/plain", b"not found\n")
-        except (ValueError, TypeError) as error:
+        except (ValueError, TypeError, RecursionError) as error:
             self._json({"error": str(error)}, HTTPStatus.BAD_REQUEST)
 
     def _status(self):
@@ -899,7 +940,7 @@ class ViewerHandler(BaseHTTPRequestHandler):
         try:
             with open(path, "rb") as file:
                 body = file.read()
-        except OSError:
+        except (OSError, ValueError):  # ValueError: a NUL in the name
             self._send(HTTPStatus.NOT_FOUND, "text/plain", b"not found\n")
             return
         self._send(HTTPStatus.OK, content_type, body)
@@ -965,7 +1006,8 @@ class ViewerHandler(BaseHTTPRequestHandler):
 
 def make_server(frames, port, host="127.0.0.1", directory=None, follower=None, drive=None):
     handler = type("BoundViewerHandler", (ViewerHandler,), {
-        "frames": frames, "directory": directory, "follower": follower, "drive": drive})
+        "frames": frames, "directory": directory, "follower": follower, "drive": drive,
+        "loopback_only": host in ("127.0.0.1", "localhost", "::1")})
     server = ThreadingHTTPServer((host, port), handler)
     server.daemon_threads = True
     return server
@@ -989,6 +1031,9 @@ def main(argv=None):
     directory = SessionDirectory(client, frames, once_log, args.server)
     drive = DriveController(client, follower, once_log)
     httpd = make_server(frames, args.port, args.host, directory, follower, drive)
+    if args.host not in ("127.0.0.1", "localhost", "::1"):
+        log(f"warning: listening on {args.host}: whoever reaches this port sees the sessions and "
+            f"may drive one with this viewer's token")
     signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(0))
     print(f"viewer: http://{args.host}:{httpd.server_address[1]}/ following "
           f"{args.session or 'the first session'} on {args.server}", flush=True)

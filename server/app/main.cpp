@@ -124,6 +124,12 @@ int main(int argc, char** argv) {
       return 1;
     }
     spdlog::info("metrics on http://{}/metrics (port {})", config->metrics_listen, metrics->port());
+    if (!rpc::loopback_only(config->metrics_listen)) {
+      spdlog::warn(
+          "metrics listen beyond loopback ({}), without TLS or tokens: keep that network "
+          "private",
+          config->metrics_listen);
+    }
   }
   session::SchedulerOptions options;
   options.observer = metrics;

@@ -3,10 +3,12 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -208,12 +210,23 @@ std::optional<ServerConfig> parse_config(int argc, char** argv, int* exit_code) 
   app.set_version_flag("--version", std::string("downpour-server ") + kVersion);
   app.set_config("--config", "",
                  "read flags from this file (TOML or INI: one `flag = value` a line, without "
-                 "the dashes); the command line wins over it")
-      ->envname("DOWNPOUR_CONFIG");
+                 "the dashes; also DOWNPOUR_CONFIG). The command line wins over the file, the "
+                 "file over the environment's DOWNPOUR_<FLAG>");
+  // CLI11 reads no environment variable for the config option itself: DOWNPOUR_CONFIG is given
+  // as the flag, unless the command line names a file.
+  std::vector<std::string> args(argv, argv + argc);
+  const char* config_env = std::getenv("DOWNPOUR_CONFIG");
+  if (config_env && *config_env && std::find(args.begin(), args.end(), "--config") == args.end()) {
+    args.insert(args.begin() + 1, {"--config", config_env});
+  }
+  std::vector<char*> arg_pointers;
+  for (std::string& a : args) arg_pointers.push_back(a.data());
   try {
-    app.parse(argc, argv);
+    app.parse(static_cast<int>(arg_pointers.size()), arg_pointers.data());
   } catch (const CLI::ParseError& e) {
-    *exit_code = app.exit(e);
+    // --help and --version exit 0; every refused configuration exits 2, as a server that will
+    // not start for its security does.
+    *exit_code = app.exit(e) == 0 ? 0 : 2;
     return std::nullopt;
   }
   std::transform(renderer.begin(), renderer.end(), renderer.begin(), ::tolower);

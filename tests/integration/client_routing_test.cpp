@@ -21,7 +21,9 @@ v1::CreateSessionRequest small_request() {
 
 TEST(ClientRoutingTest, ASessionsCallsGoToTheEndpointItsServerAdvertises) {
   const std::string a_address = "127.0.0.1:" + std::to_string(free_port());
-  ServerProcess a({"--listen", a_address, "--advertise", a_address});
+  // With metrics on, so that the sanitizer runs see their observer and interceptor at work.
+  ServerProcess a(
+      {"--listen", a_address, "--advertise", a_address, "--metrics-listen", "127.0.0.1:0"});
   // B says that its sessions live on A, as a misconfigured replica would: the client follows.
   ServerProcess b({"--advertise", a_address});
 

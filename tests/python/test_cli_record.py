@@ -160,16 +160,20 @@ class CommandLineServerTest(unittest.TestCase):
         lockstep = self.cli("play", self.scenario_path, "--frames", "5")
         self.assertEqual(lockstep.returncode, 0, lockstep.stderr)
         self.assertRegex(lockstep.stdout.splitlines()[-1], r"^frames=5 images=20 .*last_frame=5 ")
-        realtime = self.cli("play", self.scenario_path, "--mode", "realtime", "--duration", "1.5")
+        # The sanitizer runs' server is slower (DOWNPOUR_TEST_TIME_SCALE): it gets longer.
+        duration = 1.5 * float(os.environ.get("DOWNPOUR_TEST_TIME_SCALE", "1"))
+        realtime = self.cli("play", self.scenario_path, "--mode", "realtime", "--duration",
+                            str(duration))
         self.assertEqual(realtime.returncode, 0, realtime.stderr)
         summary = dict(item.split("=", 1) for item in realtime.stdout.splitlines()[-1].split())
         ticks, images = int(summary["frames"]), int(summary["images"])
-        # 30 ticks of 4 views at 20 fps in 1.5 s: a tick is counted once, whatever its views.
+        # 30 ticks of 4 views at 20 fps in 1.5 s: a tick is counted once, whatever its views
+        # (a slow reader may get a tick without some of its views).
         self.assertGreater(ticks, 5)
-        self.assertLessEqual(ticks, 32)
+        self.assertLessEqual(ticks, 20 * duration + 2)
         self.assertLessEqual(ticks, int(summary["last_frame"]))
         self.assertLessEqual(images, 4 * ticks)
-        self.assertGreater(images, 3 * ticks)
+        self.assertGreaterEqual(images, 3 * ticks)
 
     def test_watch_prints_a_line_per_tick_and_close_ends_it(self):
         info = self.client.create_session(

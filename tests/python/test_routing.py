@@ -116,6 +116,23 @@ class FakeReplicasTest(unittest.TestCase):
             client_b.close_session(info.session_id)
             self.assertNotIn(info.session_id, fake_a.sessions)
 
+    def test_a_token_goes_to_a_named_endpoint_only_over_tls_or_on_this_machine(self):
+        _, _, a = self.replicas[0]
+        with DownpourClient(a, token="t" * 32) as client:
+            client.remember("far", "10.1.2.3:50051")
+            client.remember("near", "127.0.0.1:50999")
+            self.assertEqual(client.endpoint_of("far"), a)  # not followed: plaintext token
+            self.assertEqual(client.endpoint_of("near"), "127.0.0.1:50999")
+        with DownpourClient(a) as client:  # no token to leak
+            client.remember("far", "10.1.2.3:50051")
+            self.assertEqual(client.endpoint_of("far"), "10.1.2.3:50051")
+        from downpour_client.client import is_loopback
+        for target, local in (("localhost:1", True), ("127.0.0.9:1", True), ("[::1]:5", True),
+                              ("unix:/tmp/s", True), ("ipv4:127.0.0.1:5", True),
+                              ("dns:///a.example:5", False), ("10.0.0.1:5", False),
+                              ("localhost.evil.example:5", False)):
+            self.assertEqual(is_loopback(target), local, target)
+
     def test_list_shows_the_endpoint(self):
         _, fake_a, a = self.replicas[0]
         info = fake_a.CreateSession(pb.CreateSessionRequest(views=[view_spec("RAIN", 16, 16)]),

@@ -111,12 +111,37 @@ class ViewerTest(unittest.TestCase):
         status = self.wait_for(lambda s: s["session_id"] == second and s["views"])
         self.assertEqual(status["state"], "watching")
 
-    def post(self, path, body):
+    def post(self, path, body, headers=None):
         connection = http.client.HTTPConnection("127.0.0.1", self.port, timeout=10)
-        connection.request("POST", path, json.dumps(body),
-                           {"Content-Type": "application/json"})
+        data = body if isinstance(body, (bytes, str)) else json.dumps(body)
+        connection.request("POST", path, data,
+                           dict({"Content-Type": "application/json"}, **(headers or {})))
         response = connection.getresponse()
-        return response.status, json.loads(response.read())
+        raw = response.read()
+        try:
+            return response.status, json.loads(raw)
+        except ValueError:
+            return response.status, raw.decode(errors="replace")
+
+    def test_only_its_own_pages_may_drive_it(self):
+        start = {"width": 96, "height": 54}
+        # Another site's page (the browser names it), and a name rebound to 127.0.0.1.
+        for headers in ({"Origin": "http://evil.example"}, {"Sec-Fetch-Site": "cross-site"},
+                        {"Host": "evil.example:8080"}):
+            self.assertEqual(self.post("/api/drive/start", start, headers)[0], 403, headers)
+        self.assertEqual(self.get("/status.json")[0], 200)
+        self.assertEqual(self.fake.sessions, {})
+        # Bodies that are too large, nested too deep, or of the wrong kind: 400, nothing started.
+        self.assertEqual(self.post("/api/drive/controls", "[" * 30000 + "]" * 30000)[0], 400)
+        self.assertEqual(self.post("/api/drive/start", b"x" * 70000)[0], 400)
+        self.assertEqual(self.post("/api/drive/start", {"width": "wide"})[0], 400)
+        self.assertEqual(json.loads(self.get("/api/drive/state.json")[2])["state"], "idle")
+        # The page itself (same origin) may.
+        code, drive = self.post("/api/drive/start", start,
+                                {"Origin": f"http://127.0.0.1:{self.port}",
+                                 "Sec-Fetch-Site": "same-origin"})
+        self.assertEqual((code, drive["state"]), (200, "driving"))
+        self.post("/api/drive/stop", {})
 
     def test_frame_stats_history_and_session_list(self):
         session_id = self.create_session()

@@ -1,5 +1,6 @@
 #include "downpour/client.hpp"
 
+#include <algorithm>
 #include <utility>
 
 namespace downpour::client {
@@ -11,6 +12,21 @@ namespace {
 
 void check(const grpc::Status& status) {
   if (!status.ok()) throw Error(status);
+}
+
+// Whether a gRPC target names this machine (a unix socket, localhost, 127.x, ::1).
+bool is_loopback(std::string target) {
+  if (target.rfind("unix:", 0) == 0) return true;
+  for (const char* scheme : {"dns:///", "ipv4:", "ipv6:"}) {
+    if (target.rfind(scheme, 0) == 0) target = target.substr(std::string(scheme).size());
+  }
+  std::string host = target;
+  if (!host.empty() && host.front() == '[') {
+    host = host.substr(1, host.find(']') - 1);
+  } else if (std::count(host.begin(), host.end(), ':') == 1) {
+    host = host.substr(0, host.find(':'));
+  }
+  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
 }
 
 }  // namespace
@@ -50,7 +66,11 @@ v1::SessionInfo Client::create_session(const v1::CreateSessionRequest& request) 
   prepare(context);
   v1::SessionInfo info;
   check(stub_->CreateSession(&context, request, &info));
-  if (!info.endpoint().empty() && info.endpoint() != options_.target) {
+  // The token goes to a server-named endpoint only over TLS (its certificate checked against
+  // our CA) or to this machine.
+  const bool may_follow =
+      !options_.tls_ca_pem.empty() || options_.token.empty() || is_loopback(info.endpoint());
+  if (!info.endpoint().empty() && info.endpoint() != options_.target && may_follow) {
     std::lock_guard lock(mutex_);
     endpoints_[info.session_id()] = info.endpoint();
   }
@@ -64,8 +84,8 @@ void Client::close_session(const std::string& session_id) {
   request.set_session_id(session_id);
   v1::CloseSessionResponse response;
   const grpc::Status status = stub_for(session_id).CloseSession(&context, request, &response);
-  {
-    std::lock_guard lock(mutex_);
+  if (status.ok() || status.error_code() == grpc::StatusCode::NOT_FOUND) {
+    std::lock_guard lock(mutex_);  // gone: a failed close may be tried again, at the same place
     endpoints_.erase(session_id);
   }
   check(status);

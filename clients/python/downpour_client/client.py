@@ -2,6 +2,7 @@
 
 import collections
 import itertools
+import logging
 import os
 import threading
 import time
@@ -17,6 +18,8 @@ from .security import add_security_arguments, security_options  # noqa: F401
 
 # Four views at the largest size can exceed gRPC's default limit of 4 MiB per message.
 _MAX_MESSAGE_BYTES = 64 * 1024 * 1024
+
+_log = logging.getLogger("downpour_client")
 
 
 class _CallDetails(collections.namedtuple(
@@ -53,6 +56,18 @@ class _BearerToken(grpc.UnaryUnaryClientInterceptor, grpc.UnaryStreamClientInter
 def _read(path):
     with open(path, "rb") as file:
         return file.read()
+
+
+def is_loopback(target):
+    """Whether a gRPC target names this machine (a unix socket, localhost, 127.x, ::1)."""
+    if target.startswith("unix:"):
+        return True
+    for scheme in ("dns:///", "ipv4:", "ipv6:"):
+        if target.startswith(scheme):
+            target = target[len(scheme):]
+    host = target.rsplit(":", 1)[0] if target.count(":") == 1 or target.startswith("[") else target
+    host = host.strip("[]").lower()
+    return host in ("localhost", "::1") or host.startswith("127.")
 
 
 class DownpourClient:
@@ -133,11 +148,22 @@ class DownpourClient:
         this client's own target, routes it here."""
         if not isinstance(session, str):
             session, endpoint = session.session_id, getattr(session, "endpoint", "")
+        if endpoint and endpoint != self.target and not self._may_follow(endpoint):
+            _log.warning("not following session %s to %s: this client's token would go there "
+                         "in plaintext (connect with TLS)", session, endpoint)
+            endpoint = ""
         with self._lock:
             if endpoint and endpoint != self.target:
                 self._endpoints[session] = endpoint
             else:
                 self._endpoints.pop(session, None)
+
+    def _may_follow(self, endpoint):
+        """Whether calls may go to a server-named endpoint: the token is only sent over TLS (the
+        endpoint's certificate is checked against this client's CA) or to this machine."""
+        if self._credentials is not None or not self._token:
+            return True
+        return is_loopback(endpoint)
 
     def forget(self, session_id):
         with self._lock:

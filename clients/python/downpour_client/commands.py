@@ -122,13 +122,15 @@ class Player:
     def _realtime_requests(self):
         period = 1.0 / self.scenario.fps
         tick = 0
+        first = True  # the first request sent names the session, whichever tick it is
         while True:
             behind = time.monotonic() - self.started
             tick = max(tick, int(behind / period))  # skip ticks missed while we were slow
             if self._stop.wait(max(0.0, tick * period - behind)):
                 return
-            yield pb.DriveRequest(session_id=self.session_id if tick == 0 else "",
+            yield pb.DriveRequest(session_id=self.session_id if first else "",
                                   update=self.scenario.at(tick * period), dt_s=0.0)
+            first = False
             tick += 1
 
     def _record(self, frames):

@@ -67,7 +67,27 @@ TEST(ServerConfigTest, AConfigFileSetsFlagsAndTheCommandLineWins) {
   EXPECT_EQ(c->metrics_listen, "127.0.0.1:9100");
   EXPECT_EQ(c->max_fps, 25.0);
   EXPECT_FALSE(parse({"--config", "/nonexistent/downpour.toml"}, &code));
-  EXPECT_NE(code, 0);
+  EXPECT_EQ(code, 2);
+}
+
+TEST(ServerConfigTest, TheConfigFileMayComeFromTheEnvironmentAndWinsOverItsFlags) {
+  char path[] = "/tmp/downpour_config_XXXXXX";
+  const int fd = mkstemp(path);
+  ASSERT_GE(fd, 0);
+  close(fd);
+  std::ofstream(path) << "max-sessions = 3\n";
+  setenv("DOWNPOUR_CONFIG", path, 1);
+  setenv("DOWNPOUR_MAX_SESSIONS", "5", 1);
+  setenv("DOWNPOUR_MAX_FPS", "40", 1);
+  int code = -1;
+  auto c = parse({}, &code);
+  unsetenv("DOWNPOUR_CONFIG");
+  unsetenv("DOWNPOUR_MAX_SESSIONS");
+  unsetenv("DOWNPOUR_MAX_FPS");
+  std::remove(path);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->max_sessions, 3);  // the file's
+  EXPECT_EQ(c->max_fps, 40.0);    // the environment's, where the file says nothing
 }
 
 TEST(LogFormatTest, JsonFieldsNameTheSessionAndEscapeTheMessage) {

@@ -47,7 +47,9 @@ struct Options {
 
 // Several servers may answer to one name (a headless Service): a session lives on the one that
 // created it, which names itself in SessionInfo.endpoint. The client sends every later call for a
-// session it created to that endpoint (same credentials), over a channel of its own.
+// session it created to that endpoint (same credentials), over a channel of its own; with a token
+// and no TLS, only an endpoint on this machine (the token is not sent elsewhere in plaintext).
+// Not movable (it holds a mutex): keep it where it is made, or in a unique_ptr.
 class Client {
  public:
   explicit Client(Options options = {});
