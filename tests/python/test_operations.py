@@ -4,7 +4,6 @@ session lives (--advertise), and its health service described by reflection (as 
 import json
 import os
 import re
-import socket
 import time
 import unittest
 import urllib.request
@@ -16,18 +15,13 @@ from downpour.v1 import downpour_pb2 as pb
 from grpc_health.v1 import health_pb2
 from google.protobuf import descriptor_pb2
 
+from server_process import free_port
 from test_server import REPO, SERVER, ServerProcessCase, inputs
 
 
 def setUpModule():
     if not SERVER:
         raise unittest.SkipTest("DOWNPOUR_SERVER is not set")
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def project_version():
