@@ -314,13 +314,17 @@ json measure_rain(const sim::Scenario& scenario, int frames, double warm_s) {
 // session whose scene has run for warm_s before the render thread starts.
 struct Pipeline {
   session::SessionRegistry registry{1, [this] { scheduler.wake(); }};
-  session::FrameScheduler scheduler{registry, {g_renderer, g_encoder_threads}};
+  session::FrameScheduler scheduler{registry, {g_renderer, g_encoder_threads, false, nullptr}};
   std::shared_ptr<session::Session> session;
 
   Pipeline(const sim::Scenario& scenario, std::vector<sim::ViewSpec> views, sim::Mode mode,
            double warm_s) {
-    session = registry.create({std::move(views), mode, scenario.fps, scenario.seed, {}},
-                              scenario.at(0.0));
+    session::SessionConfig config;
+    config.views = std::move(views);
+    config.mode = mode;
+    config.fps = scenario.fps;
+    config.seed = scenario.seed;
+    session = registry.create(std::move(config), scenario.at(0.0));
     warm(session->simulation(), scenario, warm_s);  // no render thread yet
     scheduler.start();
   }
