@@ -227,5 +227,23 @@ class RealServersTest(unittest.TestCase):
                 client.close_session(info.session_id)
 
 
+    def test_the_command_line_watches_and_closes_a_session_elsewhere_by_its_endpoint(self):
+        with DownpourClient(self.a) as client_a:
+            info = client_a.create_session([view_spec("RAIN", 64, 36)], mode="REALTIME", fps=10)
+
+            def cli(*args):
+                return subprocess.run([sys.executable, "-m", "downpour_client", *args,
+                                       "--server", self.b, "--endpoint", self.a],
+                                      env=CLIENT_ENV, capture_output=True, text=True, timeout=60)
+
+            watched = cli("watch", info.session_id, "--frames", "2")
+            self.assertEqual(watched.returncode, 0, watched.stderr)
+            self.assertEqual(len([line for line in watched.stdout.splitlines()
+                                  if line.startswith("frame")]), 2, watched.stdout)
+            closed = cli("close", info.session_id)
+            self.assertEqual(closed.returncode, 0, closed.stderr)
+            self.assertEqual(client_a.list_sessions(), [])
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -85,6 +85,9 @@ def build_parser():
                     "frame number, sim time and stats (or with --json a JSON line per frame); "
                     "ends with the session, after --frames ticks, or on Ctrl-C.")
     watch_parser.add_argument("session_id", metavar="SESSION_ID")
+    watch_parser.add_argument("--endpoint", metavar="HOST:PORT",
+                              help="the server that holds the session (SessionInfo.endpoint, as "
+                                   "list prints it), when --server names several")
     watch_parser.add_argument("--views", nargs="+", metavar="VIEW",
                               help="the views watched (default: every view of the session)")
     watch_parser.add_argument("--out", metavar="DIR",
@@ -98,6 +101,8 @@ def build_parser():
 
     close_parser = commands.add_parser("close", parents=[common], help="close a session")
     close_parser.add_argument("session_id", metavar="SESSION_ID")
+    close_parser.add_argument("--endpoint", metavar="HOST:PORT",
+                              help="the server that holds the session, when --server names several")
     close_parser.set_defaults(func=_command("close"))
 
     commands.add_parser("list", parents=[common], help="list the server's sessions") \

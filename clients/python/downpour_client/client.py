@@ -178,8 +178,11 @@ class DownpourClient:
         """The Downpour stub that reaches the server holding session_id."""
         with self._lock:
             endpoint = self._endpoints.get(session_id)
-            if endpoint is None:
-                return self.stub
+        return self.stub if endpoint is None else self._stub_at(endpoint)
+
+    def _stub_at(self, endpoint):
+        """The stub of another server, over a channel made on first use."""
+        with self._lock:
             entry = self._stubs.get(endpoint)
             if entry is None:
                 channel = self._open_channel(endpoint)
@@ -218,6 +221,16 @@ class DownpourClient:
         """The sessions of the server at this client's target (not those of other replicas)."""
         return list(self.stub.ListSessions(pb.ListSessionsRequest(),
                                            timeout=self.timeout_s).sessions)
+
+    def list_sessions_at(self, endpoint):
+        """The sessions the server at endpoint lists (this client's credentials; the same token
+        rule as for following a session)."""
+        if endpoint == self.target:
+            return self.list_sessions()
+        if not self._may_follow(endpoint):
+            raise ValueError(f"{endpoint}: this client's token would go there in plaintext")
+        return list(self._stub_at(endpoint).ListSessions(pb.ListSessionsRequest(),
+                                                         timeout=self.timeout_s).sessions)
 
     def find_session(self, session_id):
         """The SessionInfo of session_id from list_sessions(), remembered for routing; None when

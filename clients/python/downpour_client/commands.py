@@ -244,8 +244,17 @@ def stats(args):
     return 0
 
 
-def _route(client, session_id):
-    """The session's SessionInfo if the server lists it (its endpoint remembered), else None."""
+def _route(client, session_id, endpoint=None):
+    """The session's SessionInfo if the server that holds it lists it (its endpoint remembered),
+    else None. endpoint: where the session lives (SessionInfo.endpoint), when known; the server
+    at --server is asked otherwise."""
+    if endpoint:
+        client.remember(session_id, endpoint)
+        try:
+            return next((s for s in client.list_sessions_at(endpoint)
+                         if s.session_id == session_id), None)
+        except grpc.RpcError:
+            return None
     try:
         return client.find_session(session_id)
     except grpc.RpcError:
@@ -254,7 +263,7 @@ def _route(client, session_id):
 
 def close(args):
     with _connect(args) as client:
-        _route(client, args.session_id)
+        _route(client, args.session_id, args.endpoint)
         client.close_session(args.session_id)
         print(f"closed {args.session_id}", flush=True)
     return 0
@@ -306,7 +315,7 @@ def watch(args):
     if args.out:
         os.makedirs(args.out, exist_ok=True)
     with _connect(args) as client:
-        info = _route(client, args.session_id)
+        info = _route(client, args.session_id, args.endpoint)
         expected = len(views) if views else (len(info.views) if info is not None else None)
         call = client.watch_frames(args.session_id, views, args.max_fps)
         stopped = threading.Event()
