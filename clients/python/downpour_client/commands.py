@@ -431,24 +431,27 @@ class VideoWriter:
             self._file.close()
         except BrokenPipeError:
             pass
-        if self.frames == 0:
-            if self._process is not None:
-                self._process.wait()
-            try:
-                os.remove(self.path)
-            except OSError:
-                pass
-            return
-        if self._process is None:
-            return
         try:
-            code = self._process.wait(timeout=120)
-        except subprocess.TimeoutExpired:
-            self._process.kill()
-            code = self._process.wait()
-        if code != 0:
-            raise RuntimeError(f"ffmpeg failed ({code}): {self._ffmpeg_errors()}")
-        self._errors.close()
+            if self.frames == 0:
+                if self._process is not None:
+                    self._process.wait()
+                try:
+                    os.remove(self.path)
+                except OSError:
+                    pass
+                return
+            if self._process is None:
+                return
+            try:
+                code = self._process.wait(timeout=120)
+            except subprocess.TimeoutExpired:
+                self._process.kill()
+                code = self._process.wait()
+            if code != 0:
+                raise RuntimeError(f"ffmpeg failed ({code}): {self._ffmpeg_errors()}")
+        finally:
+            if self._errors is not None:
+                self._errors.close()
 
     def _ffmpeg_errors(self):
         self._errors.seek(0)
