@@ -24,6 +24,17 @@ def accepts_flag(flag):
     return flag in result.stdout + result.stderr
 
 
+def terminate(process, timeout_s=15):
+    """SIGTERM (the server drains), then a kill past timeout_s; the exit status."""
+    if process.poll() is None:
+        process.send_signal(signal.SIGTERM)
+    try:
+        return process.wait(timeout=timeout_s)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        return process.wait()
+
+
 class ServerProcess:
     """Starts the server on 127.0.0.1:port (a free one when None) with extra args; self.target is
     its address once start() returned; stop() ends it and returns (exit code, log tail)."""
@@ -56,13 +67,7 @@ class ServerProcess:
         return self.log.read().decode(errors="replace")[-4000:]
 
     def stop(self):
-        if self.process.poll() is None:
-            self.process.send_signal(signal.SIGTERM)
-        try:
-            code = self.process.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            self.process.kill()
-            code = self.process.wait()
+        code = terminate(self.process)
         log = self.tail()
         self.log.close()
         self.folder.cleanup()

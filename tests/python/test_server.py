@@ -17,6 +17,7 @@ import grpc
 from PIL import Image
 
 from downpour_client import DownpourClient, view_spec
+from server_process import terminate
 from downpour.v1 import downpour_pb2 as pb
 
 SERVER = os.environ.get("DOWNPOUR_SERVER")
@@ -108,12 +109,7 @@ class ServerProcessCase(unittest.TestCase):
     def _stop_server(cls):
         if cls.client is not None:
             cls.client.close()
-        cls.process.send_signal(signal.SIGTERM)
-        try:
-            code = cls.process.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            cls.process.kill()
-            code = cls.process.wait()
+        code = terminate(cls.process)
         log = cls._log()
         cls.log.close()
         cls.folder.cleanup()
