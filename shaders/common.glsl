@@ -100,3 +100,8 @@ vec3 to_display(vec3 c) {
   c = c / (1.0 + 0.15 * c);
   return sqrt(clamp(c, 0.0, 1.0));
 }
+// Its inverse: the radiance a display-encoded colour stands for (up to the shoulder's 1.18).
+vec3 from_display(vec3 d) {
+  vec3 c = d * d;
+  return c / max(1.0 - 0.15 * c, 0.05);
+}

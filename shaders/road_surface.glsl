@@ -161,12 +161,6 @@ vec3 ripple_slope(vec2 xy, float standing_mm) {
 #endif
 
 #ifdef ROAD_MIRROR
-// The display's encoding undone (common.glsl's to_display): the mirror is stored as displayed.
-vec3 from_display(vec3 c) {
-  vec3 x = c * c;
-  return x / max(1.0 - 0.15 * x, 0.05);
-}
-
 // What the ray r from p on the road sees in the quarter-size mirror (`sky` where it sees none):
 // where the mirror image of the pixel lies (its depth), how far along r that is, and where that
 // point's mirror image falls.

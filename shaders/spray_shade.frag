@@ -60,10 +60,6 @@ vec3 back_normal(int object, ivec2 px, float z0) {
   return normal;
 }
 
-vec3 from_display(vec3 c) {
-  c = c * c;
-  return c / max(1.0 - 0.15 * c, 0.05);
-}
 vec3 sky(vec3 dir_view) { return sky_gradient(normalize(mat3(u_view_to_world) * dir_view)); }
 float scene_z(vec2 px) {
   ivec2 full = ivec2(clamp(px, vec2(0.0), u_size - 1.0)) * u_scale;

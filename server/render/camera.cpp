@@ -5,6 +5,7 @@
 
 #include <glm/trigonometric.hpp>
 
+#include "server/render/atmosphere.hpp"
 #include "server/render/vehicle_geometry.hpp"
 #include "server/sim/pose.hpp"
 
@@ -12,7 +13,7 @@ namespace downpour::render {
 namespace {
 
 constexpr double kEyeFocusM = 20.0;  // the road ahead
-constexpr double kEyePupilMm = 4.0;  // an overcast day
+constexpr double kEyePupilMm = 4.0;  // an overcast day, where the weather is not given
 constexpr double kCameraFocusM = 3.0;
 constexpr double kCameraApertureMm = 2.0;
 
@@ -31,7 +32,17 @@ double default_fov_deg(sim::View view) { return view == sim::View::kRoad ? 55.0 
 
 sim::CameraPose dash_camera_pose() { return {{1.52, 0.0, 1.21}, {0.0, 3.0, 0.0}}; }
 
-Camera make_camera(const sim::ViewSpec& spec, const sim::VehicleState& vehicle) {
+double eye_pupil_mm(const sim::Weather& weather) {
+  // The scene's luminance: the sky's light on the world, as the frame's exposure shows it (a white
+  // card under E lux shows E * lux_exposure; its luminance is E / pi).
+  const Atmosphere a = atmosphere_from(weather);
+  const double shown = (a.ambient.r + a.ambient.g + a.ambient.b) / 3.0;
+  const double luminance = std::max(shown / (M_PI * a.lux_exposure), 1e-6);
+  return 4.9 - 3.0 * std::tanh(0.4 * std::log10(luminance));
+}
+
+Camera make_camera(const sim::ViewSpec& spec, const sim::VehicleState& vehicle,
+                   const sim::Weather* weather) {
   const sim::CameraPose pose =
       spec.camera ? *spec.camera : default_camera_pose(spec.view, spec.eye_m);
   // Camera frame in the vehicle frame, then GL's camera axes (x right, y up, looking down -z).
@@ -50,7 +61,9 @@ Camera make_camera(const sim::ViewSpec& spec, const sim::VehicleState& vehicle) 
   // The eye focuses on the road through its pupil; a camera of its own sees the glass's water
   // sharper (a small lens focused nearer).
   c.focus_m = spec.focus_distance_m.value_or(spec.camera ? kCameraFocusM : kEyeFocusM);
-  c.aperture_mm = spec.aperture_mm.value_or(spec.camera ? kCameraApertureMm : kEyePupilMm);
+  c.aperture_mm = spec.aperture_mm.value_or(spec.camera ? kCameraApertureMm
+                                            : weather   ? eye_pupil_mm(*weather)
+                                                        : kEyePupilMm);
   c.position = glm::vec3(cam_to_world[3]);
   // A camera in the cabin may sit a few centimetres from the raked glass.
   if (spec.view == sim::View::kCockpit || spec.view == sim::View::kRain) c.near_m = 0.01f;

@@ -35,7 +35,14 @@ double default_fov_deg(sim::View view);
 sim::CameraPose dash_camera_pose();
 
 // The view's camera: ViewSpec::camera where given (ROAD: an outside camera; COCKPIT: a camera in
-// the cabin, e.g. dash_camera_pose(), instead of the driver's eye), else the view's default.
-Camera make_camera(const sim::ViewSpec& spec, const sim::VehicleState& vehicle);
+// the cabin, e.g. dash_camera_pose(), instead of the driver's eye), else the view's default. The
+// driver's eye opens its pupil to the light of `weather` (eye_pupil_mm); without it, to an
+// overcast day's (4 mm).
+Camera make_camera(const sim::ViewSpec& spec, const sim::VehicleState& vehicle,
+                   const sim::Weather* weather = nullptr);
+
+// The eye's pupil (mm) adapted to the light of this weather: Moon and Spencer's
+// D = 4.9 - 3 tanh(0.4 log10 L), L the scene's luminance (cd/m^2): about 2 mm by day, 6 at night.
+double eye_pupil_mm(const sim::Weather& weather);
 
 }  // namespace downpour::render

@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
 
 #include "server/render/atmosphere.hpp"
@@ -59,12 +60,12 @@ struct FrameResources {
   GLuint view_fbo = 0;
   TargetTexture view_colour;
   TargetTexture view_depth;
-  GLuint scene_blur_fbo = 0;
-  TargetTexture scene_blur;
   GLuint glass_layer_fbo = 0;
   TargetTexture glass_layer;
-  TargetTexture glass_water;      // the session's glass water map
-  TargetTexture road_reflection;  // drawn before the passes where the view reads it
+  TargetTexture glass_water;  // the session's glass water map
+  TargetTexture environment;  // the session's environment probe (a cube map: a face's size)
+  glm::mat3 environment_from_world{1.0f};  // turns world directions into the probe's axes
+  TargetTexture road_reflection;           // drawn before the passes where the view reads it
   TargetTexture road_reflection_depth;
   GLuint spray_layer_fbo = 0;
   TargetTexture spray_layer;

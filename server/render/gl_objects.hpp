@@ -64,7 +64,9 @@ class Uniform {
   Uniform(GLuint program, GLint location) : program_(program), location_(location) {}
   void set(float v) const { glProgramUniform1f(program_, location_, v); }
   void set(int v) const { glProgramUniform1i(program_, location_, v); }
+  void set(unsigned v) const { glProgramUniform1ui(program_, location_, v); }
   void set(glm::vec2 v) const { glProgramUniform2f(program_, location_, v.x, v.y); }
+  void set(glm::ivec2 v) const { glProgramUniform2i(program_, location_, v.x, v.y); }
   void set(glm::vec3 v) const { glProgramUniform3f(program_, location_, v.x, v.y, v.z); }
   void set(glm::vec4 v) const { glProgramUniform4f(program_, location_, v.x, v.y, v.z, v.w); }
   void set(const glm::mat4& m) const;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "server/sim/glass_water_surface.hpp"
+
 namespace downpour::render {
 
 GlassPlacement::GlassPlacement(const ShaderProgram& program)
@@ -40,7 +42,8 @@ bool glass_has_water_or_blades(const sim::WindshieldState& water) {
   const bool any_blade =
       std::any_of(water.blades.begin(), water.blades.end(),
                   [](const sim::BladePose& b) { return b.length_mm > 0.0f && b.width_mm > 0.0f; });
-  return any_blade || water.map.wet_fraction > 0.0 || !water.metaballs.empty();
+  return any_blade || water.map.wet_fraction > 0.0 || !water.metaballs.empty() ||
+         (water.surface && !water.surface->bodies.empty());
 }
 
 }  // namespace downpour::render

@@ -7,13 +7,16 @@
 
 namespace downpour::render {
 
-GlassView::GlassView(const Camera& camera, const sim::GlassConfig& glass, int image_height)
+GlassView::GlassView(const Camera& camera, const sim::GlassConfig& glass, int image_height,
+                     int min_layer_scale)
     : glass_(glass),
       origin_(camera.position_vehicle),
       axes_(camera.axes_vehicle),
       tan_x_(camera.tan_half_fov_x),
       tan_y_(camera.tan_half_fov_y),
-      near_m_(camera.near_m) {
+      near_m_(camera.near_m),
+      min_layer_scale_(min_layer_scale),
+      pinhole_(camera.aperture_mm <= 0.0) {
   const glm::dvec3 n = glass_.normal();
   const double facing = glm::dot(axes_[0], n);
   const double gap = glm::dot(glass_.bottom_left_m - origin_, n);
@@ -58,7 +61,9 @@ glm::vec4 GlassView::screen_axes() const {
 }
 
 int GlassView::layer_scale() const {
-  return std::clamp(static_cast<int>(std::lround(blur_px())), 1, 4);
+  if (pinhole_) return 1;
+  return std::clamp(static_cast<int>(std::lround(blur_px())), std::clamp(min_layer_scale_, 1, 4),
+                    4);
 }
 
 }  // namespace downpour::render

@@ -19,7 +19,10 @@ namespace downpour::render {
 class GlassView {
  public:
   GlassView() = default;  // a view that does not look through the glass
-  GlassView(const Camera& camera, const sim::GlassConfig& glass, int image_height);
+  // min_layer_scale: the least reduction of the water layer where the lens blurs at all (a
+  // renderer without a GPU pays for every pixel of it; a pinhole's layer is always full size).
+  GlassView(const Camera& camera, const sim::GlassConfig& glass, int image_height,
+            int min_layer_scale = 1);
 
   // The glass-space point (mm) where the ray through image point (x right, y up, both in [-1, 1]
   // across the image) meets the glass's plane in front of the camera; none if it does not.
@@ -39,7 +42,8 @@ class GlassView {
   double blur_mm() const { return blur_mm_; }
   double blur_px() const { return blur_mm_ * pixels_per_mm_; }
   // The water layer is drawn at 1 / layer_scale of the image's size: its pixels as wide as the
-  // blur (the bilinear upsampling then blurs as much), 1 (sharp) to 4.
+  // blur (the bilinear upsampling then blurs as much), 1 (sharp) to 4; no less than the minimum
+  // unless the lens is a pinhole.
   int layer_scale() const;
 
  private:
@@ -51,6 +55,8 @@ class GlassView {
   double distance_m_ = 0.0;
   double pixels_per_mm_ = 0.0;
   double blur_mm_ = 0.0;
+  int min_layer_scale_ = 1;
+  bool pinhole_ = false;
 };
 
 }  // namespace downpour::render

@@ -11,12 +11,14 @@ std::string_view resource_name(Resource r) {
       return "view colour";
     case Resource::kViewDepth:
       return "view depth";
-    case Resource::kSceneBlur:
-      return "scene blur";
     case Resource::kGlassLayer:
       return "glass layer";
     case Resource::kGlassWater:
       return "glass water map";
+    case Resource::kGlassSurface:
+      return "glass water surface";
+    case Resource::kEnvironment:
+      return "environment";
     case Resource::kRoadWater:
       return "road water";
     case Resource::kRoadReflection:
@@ -29,7 +31,8 @@ std::string_view resource_name(Resource r) {
 
 void check_pass_order(std::string_view view, const std::vector<Pass*>& passes) {
   // The frame provides these from its start (the simulation's, or drawn before the passes).
-  const std::vector<Resource> provided = {Resource::kGlassWater, Resource::kRoadWater,
+  const std::vector<Resource> provided = {Resource::kGlassWater, Resource::kGlassSurface,
+                                          Resource::kEnvironment, Resource::kRoadWater,
                                           Resource::kRoadReflection};
   std::vector<Resource> available = {Resource::kViewColour, Resource::kViewDepth};
   available.insert(available.end(), provided.begin(), provided.end());

@@ -18,16 +18,20 @@ namespace downpour::render {
 enum class Resource : std::uint8_t {
   kViewColour,  // the view's colour target: cleared at the frame's start
   kViewDepth,   // its depth (reversed-Z): cleared at the frame's start
-  kSceneBlur,   // the scene outside the glass, an eighth of the view
   kGlassLayer,  // the water on the glass over the scene, reduced size, premultiplied
   kGlassWater,  // the session's glass water map, uploaded from the simulation on first read
-  kRoadWater,   // the road's water around the car, uploaded from the simulation on first read
+  // The water's surface on the glass (sim::GlassWaterSurface), uploaded likewise.
+  kGlassSurface,
+  // The world outside the windshield as a cube map (environment_probe.hpp), the session's, which
+  // the renderer refreshes before the view's passes where one reads it.
+  kEnvironment,
+  kRoadWater,  // the road's water around the car, uploaded from the simulation on first read
   // The scene mirrored in the road's plane with its depth, a quarter of the view: the renderer
   // draws it before the view's passes where one reads it and the road is wet.
   kRoadReflection,
   kSprayLayer,  // the spray over the scene, half the view, premultiplied
 };
-inline constexpr std::size_t kResourceCount = 8;
+inline constexpr std::size_t kResourceCount = 9;
 std::string_view resource_name(Resource resource);
 
 struct PassDecl {

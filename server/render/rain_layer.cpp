@@ -10,17 +10,12 @@
 #include <glm/matrix.hpp>
 
 #include "server/render/cabin_tiles.hpp"
+#include "server/render/display.hpp"
 #include "server/render/light_set.hpp"
 
 namespace downpour::render {
 
 namespace {
-
-// The scene's display transform (common.glsl's to_display): a gentle shoulder, then gamma 2.
-glm::vec3 to_display(glm::vec3 c) {
-  c = glm::clamp(c / (1.0f + 0.15f * c), 0.0f, 1.0f);
-  return glm::vec3(std::sqrt(c.x), std::sqrt(c.y), std::sqrt(c.z));
-}
 
 // Terminal speed by diameter, over the field's sizes (0-8 mm).
 struct SpeedTable {

@@ -9,18 +9,20 @@
 #include <cstring>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <tuple>
 
 #include <spdlog/spdlog.h>
 #include <glm/trigonometric.hpp>
 
+#include "server/render/environment_probe.hpp"
 #include "server/render/frame_context.hpp"
 #include "server/render/lamp_map.hpp"
 #include "server/render/light_set.hpp"
 #include "server/render/pass.hpp"
 #include "server/render/passes/cockpit_pass.hpp"
-#include "server/render/passes/glass_background_pass.hpp"
+#include "server/render/passes/environment_background_pass.hpp"
 #include "server/render/passes/glass_composite_pass.hpp"
 #include "server/render/passes/glass_water_pass.hpp"
 #include "server/render/passes/lamp_glow_pass.hpp"
@@ -36,14 +38,14 @@
 #include "server/render/relief.hpp"
 #include "server/render/shader_interface.hpp"
 #include "server/render/world.hpp"
+#include "server/sim/glass_water_surface.hpp"
 #include "server/sim/pose.hpp"
 
 namespace downpour::render {
 namespace {
 
 constexpr int kReadbackSlots = 2;
-constexpr int kSceneBlurScale = 8;   // the refraction background's size, 1 / 8 of the view
-constexpr int kReflectionScale = 4;  // the road reflection's, 1 / 4
+constexpr int kReflectionScale = 4;  // the road reflection's size, 1 / 4 of the view
 constexpr std::size_t kMaxTransients = 12;
 constexpr std::chrono::seconds kFenceDeadline{10};
 
@@ -135,7 +137,8 @@ struct ViewTarget {
   }
 };
 
-// A target that lives only within a frame (the scene blur, the glass layer), kept by size.
+// A target that lives only within a frame (the glass layer, the spray layer, the road
+// reflection), kept by size.
 struct Transient {
   Texture texture;
   Texture depth;  // the road reflection's
@@ -184,12 +187,14 @@ GLuint unit_of(Resource r) {
       return texture_unit::kViewColour;
     case Resource::kViewDepth:
       return texture_unit::kViewDepth;
-    case Resource::kSceneBlur:
-      return texture_unit::kSceneBlur;
     case Resource::kGlassLayer:
       return texture_unit::kGlassLayer;
     case Resource::kGlassWater:
       return texture_unit::kGlassWater;
+    case Resource::kGlassSurface:
+      return 0;  // three texture buffers (upload_glass_surface)
+    case Resource::kEnvironment:
+      return texture_unit::kEnvironment;
     case Resource::kRoadWater:
       return texture_unit::kRoadWater;
     case Resource::kRoadReflection:
@@ -211,6 +216,14 @@ struct RenderSession::Impl {
   int water_width = 0;
   int water_height = 0;
   std::uint64_t water_stamp = 0;
+  // The water's surface on the GPU (bodies, cells, entries: buffers, read as texture buffers) and
+  // what it holds.
+  std::array<Buffer, 3> glass_surface;
+  std::array<Texture, 3> glass_surface_tex;
+  std::array<std::size_t, 3> glass_surface_bytes{};
+  std::shared_ptr<const sim::GlassWaterSurface> surface_shown;
+  // The world outside the glass, shared by the session's views (made on first use).
+  std::unique_ptr<EnvironmentProbe> environment;
   // The road's water window on the GPU and the image it shows (held, so that its address names it).
   Texture road_water;
   int road_cells = 0, road_rings = 0;
@@ -237,6 +250,16 @@ struct Renderer::Impl {
   glm::mat4 lamp_rings{0.0f};
   std::vector<std::unique_ptr<Pass>> passes;
   std::array<std::vector<Pass*>, sim::kViewCount> views;  // each view's passes, in order
+  // What draws the environment probe's faces (the world outside the glass); and, with a fixed
+  // environment, COCKPIT's passes (the probe as the background, then the glass).
+  std::vector<Pass*> environment_passes;
+  std::vector<Pass*> fixed_environment_cockpit;
+  EnvironmentConfig environment_config;
+  // The water layer's least reduction where the lens blurs at all: 2 on a CPU rasterizer
+  // (llvmpipe), which pays for every pixel of it; 1 on a GPU.
+  int min_glass_layer_scale = 1;
+  std::optional<std::array<std::vector<glm::vec3>, EnvironmentProbe::kFaces>> fixed_environment;
+
   std::map<std::tuple<Resource, int, int>, Transient> transients;
   bool profiling = false;
   std::vector<PassTiming> timings;
@@ -338,11 +361,7 @@ struct Renderer::Impl {
     t.last_frame = frame;
     t.width = width;
     t.height = height;
-    if (r == Resource::kSceneBlur) {
-      t.texture = make_texture_2d(GL_RGBA8, width, height);
-      glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_S, GL_MIRRORED_REPEAT);
-      glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_T, GL_MIRRORED_REPEAT);
-    } else if (r == Resource::kRoadReflection) {
+    if (r == Resource::kRoadReflection) {
       t.texture = make_texture_2d(GL_RGBA8, width, height);
       t.depth = make_texture_2d(GL_DEPTH_COMPONENT32F, width, height);
       for (GLuint id : {t.texture.id(), t.depth.id()}) {
@@ -402,6 +421,101 @@ struct Renderer::Impl {
                           map.rgba.data() + static_cast<std::size_t>(first) * map.width * 4);
     }
     s.water_stamp = map.stamp;
+  }
+
+  // The session's water surface on the glass brought up to the frame's (a whole upload for each
+  // new one: the step publishes one per tick), bound to its storage buffers.
+  void upload_glass_surface(RenderSession::Impl& s,
+                            std::shared_ptr<const sim::GlassWaterSurface> surface) {
+    // No water (the blades alone): an empty grid, which the optics find dry everywhere.
+    static const auto dry = std::make_shared<const sim::GlassWaterSurface>();
+    if (!surface) surface = dry;
+    if (s.surface_shown != surface) {
+      const std::array<std::pair<const void*, std::size_t>, 3> parts{{
+          {surface->bodies.data(), surface->bodies.size() * sizeof(sim::WaterBody)},
+          {surface->cells.data(), surface->cells.size() * sizeof(std::uint32_t)},
+          {surface->entries.data(), surface->entries.size() * sizeof(std::uint32_t)},
+      }};
+      constexpr GLenum kFormats[3] = {GL_RGBA32F, GL_R32UI, GL_R32UI};
+      for (std::size_t k = 0; k < parts.size(); ++k) {
+        // Grown as needed (never empty: a texture buffer needs storage), else refilled.
+        const std::size_t bytes = std::max<std::size_t>(parts[k].second, 16);
+        if (!s.glass_surface[k].id() || s.glass_surface_bytes[k] < bytes) {
+          GLuint id = 0;
+          glCreateBuffers(1, &id);
+          s.glass_surface[k] = Buffer(id);
+          s.glass_surface_bytes[k] = std::max(bytes, 2 * s.glass_surface_bytes[k]);
+          glNamedBufferStorage(id, static_cast<GLsizeiptr>(s.glass_surface_bytes[k]), nullptr,
+                               GL_DYNAMIC_STORAGE_BIT);
+          GLuint tex = 0;
+          glCreateTextures(GL_TEXTURE_BUFFER, 1, &tex);
+          s.glass_surface_tex[k] = Texture(tex);
+          glTextureBuffer(tex, kFormats[k], id);
+        }
+        if (parts[k].second > 0)
+          glNamedBufferSubData(s.glass_surface[k].id(), 0, static_cast<GLsizeiptr>(parts[k].second),
+                               parts[k].first);
+      }
+      s.surface_shown = surface;
+    }
+    const GLuint units[3] = {texture_unit::kGlassBodies, texture_unit::kGlassCells,
+                             texture_unit::kGlassEntries};
+    for (std::size_t k = 0; k < 3; ++k) glBindTextureUnit(units[k], s.glass_surface_tex[k].id());
+  }
+
+  // The session's environment probe brought up to this tick: the faces due, each drawn by the
+  // world passes from the probe's centre just outside the glass, then made linear with the sun
+  // and the lamps. The first view of a tick refreshes it; the others share it.
+  void refresh_environment(const FrameContext& f, RenderSession::Impl& s, const Mirror& mirror,
+                           bool complete) {
+    if (!s.environment) {
+      s.environment = std::make_unique<EnvironmentProbe>(environment_config);
+      if (fixed_environment) s.environment->set_fixed(*fixed_environment);
+    }
+    EnvironmentProbe& probe = *s.environment;
+    const std::vector<EnvironmentProbe::Due> due = probe.faces_due(f.scene.sim_time_s, complete);
+    if (due.empty()) return;
+    const sim::GlassConfig& glass = f.scene.glass;
+    const glm::dvec3 centre_vehicle =
+        glass.to_vehicle({0.5 * glass.bottom_width_mm, 0.5 * glass.height_mm}) +
+        glass.normal() * static_cast<double>(probe.config().clearance_m);
+    const glm::vec3 centre(f.vehicle_to_world * glm::vec4(glm::vec3(centre_vehicle), 1.0f));
+    const glm::mat3 axes(f.vehicle_to_world);  // the car's, in the world
+    const int size = probe.config().face_size;
+    // The faces' spec: the view's, square (the ego car shows its bonnet alone, as from the cabin).
+    sim::ViewSpec spec = f.spec;
+    spec.width = spec.height = size;
+    spec.camera.reset();
+    FrameResources r;
+    r.view_fbo = probe.face_fbo();
+    r.view_colour = {probe.face_colour(), size, size};
+    r.view_depth = {probe.face_depth(), size, size};
+    // Geometry's detail as far out as a face's texels are wider than the view's pixels.
+    const float view_pixel = 2.0f * static_cast<float>(f.camera.tan_half_fov_y) /
+                             static_cast<float>(std::max(f.spec.height, 1));
+    const float face_texel = 2.0f / static_cast<float>(size);
+    const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+    const float zero_depth = 0.0f;
+    for (const auto [face, world] : due) {
+      FrameContext ff{f.scene,
+                      spec,
+                      EnvironmentProbe::face_camera(face, centre, axes),
+                      f.atmosphere,
+                      f.vehicle_to_world,
+                      GlassView(),
+                      f.stepped};
+      ff.world = f.world;
+      ff.lights = f.lights;
+      ff.detail_distance_scale = std::max(face_texel / view_pixel, 1.0f);
+      upload_frame_block(ff, water_block(ff, mirror, false));
+      apply(RenderState{DepthTest::kOff, true, Blend::kOff});
+      glClearNamedFramebufferfv(r.view_fbo, GL_COLOR, 0, black);
+      glClearNamedFramebufferfv(r.view_fbo, GL_DEPTH, 0, &zero_depth);
+      for (Pass* pass : environment_passes) {
+        if (world || pass == environment_passes.back()) run_pass(*pass, ff, s, r);  // (the sky)
+      }
+      probe.resolve(face, axes, f.atmosphere, static_cast<int>(lamp_params.w));
+    }
   }
 
   // The session's road water rings brought up to the frame's: a whole upload for each new image
@@ -489,9 +603,7 @@ struct Renderer::Impl {
     // A transient that no pass of this frame drew (its pass had nothing to draw) leaves its
     // readers nothing to draw either.
     for (Resource res : d.reads) {
-      if ((res == Resource::kSceneBlur || res == Resource::kGlassLayer ||
-           res == Resource::kSprayLayer) &&
-          !written[index(res)])
+      if ((res == Resource::kGlassLayer || res == Resource::kSprayLayer) && !written[index(res)])
         return;
     }
     for (Resource res : d.reads) {
@@ -503,9 +615,6 @@ struct Renderer::Impl {
         case Resource::kViewDepth:
           texture = r.view_depth.texture;
           break;
-        case Resource::kSceneBlur:
-          texture = r.scene_blur.texture;
-          break;
         case Resource::kGlassLayer:
           texture = r.glass_layer.texture;
           break;
@@ -514,6 +623,18 @@ struct Renderer::Impl {
           r.glass_water = {session.glass_water.id(), session.water_width, session.water_height};
           texture = r.glass_water.texture;
           break;
+        case Resource::kGlassSurface:
+          upload_glass_surface(session, f.water().surface);
+          continue;  // bound to their units there
+        case Resource::kEnvironment: {
+          const EnvironmentProbe* probe = session.environment.get();
+          texture = probe ? probe->texture() : 0;
+          const int size = probe ? probe->config().face_size : 0;
+          r.environment = {texture, size, size};
+          r.environment_from_world =
+              probe ? probe->from_world(f.vehicle_to_world) : glm::mat3(1.0f);
+          break;
+        }
         case Resource::kRoadWater:
           upload_road_water(session, f.scene.road_water);
           texture = session.road_water.id();
@@ -534,17 +655,12 @@ struct Renderer::Impl {
       glViewport(0, 0, r.view_colour.width, r.view_colour.height);
     } else {
       const int w = r.view_colour.width, h = r.view_colour.height;
-      const int scale = out == Resource::kSceneBlur    ? kSceneBlurScale
-                        : out == Resource::kSprayLayer ? SprayPass::kScale
-                                                       : f.glass.layer_scale();
+      const bool spray = out == Resource::kSprayLayer;
+      const int scale = spray ? SprayPass::kScale : f.glass.layer_scale();
       Transient& t = transient(out, std::max(1, (w + scale - 1) / scale),
                                std::max(1, (h + scale - 1) / scale));
-      TargetTexture& texture = out == Resource::kSceneBlur    ? r.scene_blur
-                               : out == Resource::kSprayLayer ? r.spray_layer
-                                                              : r.glass_layer;
-      GLuint& fbo = out == Resource::kSceneBlur    ? r.scene_blur_fbo
-                    : out == Resource::kSprayLayer ? r.spray_layer_fbo
-                                                   : r.glass_layer_fbo;
+      TargetTexture& texture = spray ? r.spray_layer : r.glass_layer;
+      GLuint& fbo = spray ? r.spray_layer_fbo : r.glass_layer_fbo;
       texture = {t.texture.id(), t.width, t.height};
       fbo = t.fbo.id();
       glBindFramebuffer(GL_FRAMEBUFFER, t.fbo.id());
@@ -595,6 +711,9 @@ Renderer::~Renderer() = default;
 std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   auto impl = std::make_unique<Impl>();
   impl->context = EglContext::create(options.platform);
+  if (impl->context->renderer().find("llvmpipe") != std::string::npos ||
+      impl->context->renderer().find("softpipe") != std::string::npos)
+    impl->min_glass_layer_scale = 2;
   const SpraySmoothing smoothing = options.spray_smoothing;
 #ifndef NDEBUG
   // Debug builds: the driver's own reports of errors and misuse, in the log as they happen.
@@ -649,7 +768,7 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   RainPass* rain = impl->add<RainPass>();
   impl->rain = rain;
   Pass* rain_mask = impl->add<RainMaskPass>();
-  Pass* glass_background = impl->add<GlassBackgroundPass>();
+  Pass* environment_background = impl->add<EnvironmentBackgroundPass>();
   Pass* glass_water = impl->add<GlassWaterPass>();
   Pass* glass_composite = impl->add<GlassCompositePass>();
   Pass* windshield = impl->add<WindshieldPass>();
@@ -661,8 +780,11 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   impl->reflected = {{vehicles, -0.02f}, {street_lights, 0.0f}, {terrain, 0.5f}, {sky, 0.0f}};
   auto& views = impl->views;
   views[static_cast<int>(sim::View::kCockpit)] = {
-      cockpit, vehicles,        street_lights,    road,        terrain,        sky, glow, rain,
-      spray,   spray_composite, glass_background, glass_water, glass_composite};
+      cockpit, vehicles, street_lights,   road,        terrain,        sky, glow,
+      rain,    spray,    spray_composite, glass_water, glass_composite};
+  impl->environment_passes = {vehicles, street_lights, road, terrain, sky};  // the sky last
+  impl->fixed_environment_cockpit = {environment_background, glass_water, glass_composite};
+  check_pass_order("COCKPIT (fixed environment)", impl->fixed_environment_cockpit);
   views[static_cast<int>(sim::View::kRoad)] = {vehicles, street_lights, road,  terrain,        sky,
                                                glow,     rain,          spray, spray_composite};
   views[static_cast<int>(sim::View::kWindshield)] = {windshield};
@@ -711,6 +833,16 @@ std::uint32_t Renderer::last_rain_streaks() const { return impl_->rain_streaks; 
 
 void Renderer::release_shared_targets() { impl_->transients.clear(); }
 
+void Renderer::set_fixed_environment(std::optional<std::array<std::vector<glm::vec3>, 6>> faces,
+                                     int face_size) {
+  impl_->fixed_environment = std::move(faces);
+  if (impl_->fixed_environment)
+    impl_->environment_config.face_size = face_size;
+  else
+    impl_->environment_config = EnvironmentConfig{};
+  if (impl_->image_session) impl_->image_session->impl_->environment.reset();
+}
+
 std::unique_ptr<RenderSession> Renderer::open_session() {
   return std::unique_ptr<RenderSession>(new RenderSession(std::make_unique<RenderSession::Impl>()));
 }
@@ -743,13 +875,13 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
   target->next_slot = (slot + 1) % kReadbackSlots;
   if (target->fence[slot]) throw std::logic_error("readback slot reused before finish()");
 
-  const Camera camera = make_camera(spec, scene.vehicle);
+  const Camera camera = make_camera(spec, scene.vehicle, &scene.weather);
   FrameContext frame{scene,
                      spec,
                      camera,
                      atmosphere_from(scene.weather),
                      glm::mat4(sim::vehicle_to_world(scene.vehicle)),
-                     GlassView(camera, scene.glass, spec.height),
+                     GlassView(camera, scene.glass, spec.height, m.min_glass_layer_scale),
                      stepped};
   frame.world = &m.worlds.get(scene.roads);
   FrameResources resources;
@@ -774,11 +906,26 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
   if (m.profiling) m.timed("clear", [] {});
   m.timed("lamp_map", [&] { m.prepare_lamps(frame); });
   if (reflection) m.timed("road_reflection", [&] { m.draw_reflection(frame, mirror, resources); });
-  m.upload_frame_block(frame, Impl::water_block(frame, mirror, reflection));
+  const int view = static_cast<int>(spec.view);
+  const bool fixed = m.fixed_environment && spec.view == sim::View::kCockpit;
+  const Impl::WaterBlock view_water = Impl::water_block(frame, mirror, reflection);
+  m.upload_frame_block(frame, view_water);
   glBindFramebuffer(GL_FRAMEBUFFER, target->fbo.id());
   glViewport(0, 0, spec.width, spec.height);
   m.rain->take_drawn();
-  for (Pass* pass : m.views[static_cast<int>(spec.view)]) {
+  for (Pass* pass : fixed ? m.fixed_environment_cockpit : m.views[view]) {
+    // The world outside the glass, for the first pass that reads it and has something to draw
+    // (it waits for the step, as that pass would): then the view's frame block again.
+    const auto& reads = pass->decl().reads;
+    if (std::find(reads.begin(), reads.end(), Resource::kEnvironment) != reads.end() &&
+        pass->wanted(frame)) {
+      m.timed("glass_environment", [&] {
+        // render_image's pictures stand alone: their environment is drawn whole.
+        const bool picture = m.image_session && &s == m.image_session->impl_.get();
+        m.refresh_environment(frame, s, mirror, picture);
+      });
+      m.upload_frame_block(frame, view_water);
+    }
     m.timed(pass->decl().name, [&] { m.run_pass(*pass, frame, s, resources); });
   }
   const RainPass::Drawn rain = m.rain->take_drawn();
@@ -855,6 +1002,9 @@ void Renderer::finish(const PendingReadback& pending, std::vector<std::uint8_t>&
 std::vector<std::uint8_t> Renderer::render_image(const sim::ViewSpec& spec,
                                                  const sim::SceneState& scene) {
   if (!impl_->image_session) impl_->image_session = open_session();
+  // A picture of this scene alone: the world outside the glass drawn for it, not a session's
+  // earlier ticks.
+  if (!impl_->fixed_environment) impl_->image_session->impl_->environment.reset();
   const PendingReadback pending = render(*impl_->image_session, 0, spec, scene);
   std::vector<std::uint8_t> bottom_up;
   finish(pending, bottom_up);

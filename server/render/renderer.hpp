@@ -7,8 +7,11 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include <glm/vec3.hpp>
 
 #include "server/render/egl_context.hpp"
 #include "server/render/spray_smoothing.hpp"
@@ -111,12 +114,20 @@ class Renderer {
   // Waits if needed; out gets RGBA8 rows bottom-up.
   void finish(const PendingReadback& pending, std::vector<std::uint8_t>& out);
 
-  // Renders one view and waits for its pixels, rows top-down (tests, tools).
+  // Renders one view of the scene by itself and waits for its pixels, rows top-down (tests,
+  // tools).
   std::vector<std::uint8_t> render_image(const sim::ViewSpec& spec, const sim::SceneState& scene);
 
   // Frees the shared intermediate targets (remade on demand): after sessions close, so that the
   // memory of their sizes goes back. Between frames only.
   void release_shared_targets();
+
+  // Tests: the world outside the windshield fixed (six cube faces of linear radiance, face_size^2
+  // texels each, GL's face order, rows from the bottom) instead of drawn from the world; COCKPIT
+  // then shows it as its background too. Sessions opened after the call take it; nullopt goes
+  // back to the world.
+  void set_fixed_environment(std::optional<std::array<std::vector<glm::vec3>, 6>> faces,
+                             int face_size = 0);
 
  private:
   struct Impl;

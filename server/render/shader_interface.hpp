@@ -15,8 +15,9 @@ namespace downpour::render {
   X(kAsphalt, 2, sampler2D, asphalt_tex, "asphalt relief: rgb normal, a height (seed 003, 3.1)")   \
   X(kGlassWater, 3, sampler2D, glass_water_tex,                                                    \
     "the session's glass water map: normal uv, compressed height, coverage")                       \
-  X(kSceneBlur, 4, sampler2D, scene_blur_tex,                                                      \
-    "the scene outside the glass, an eighth of the view, mirrored repeat")                         \
+  X(kEnvironment, 4, samplerCube, environment_tex,                                                 \
+    "the world outside the windshield from its centre, world axes, linear radiance with the sun "  \
+    "and lamps at their energy, mipmapped (environment_probe.hpp)")                                \
   X(kViewColour, 5, sampler2D, view_colour_tex, "the view's colour so far")                        \
   X(kViewDepth, 6, sampler2D, view_depth_tex, "the view's depth so far (reversed-Z)")              \
   X(kGlassLayer, 7, sampler2D, glass_layer_tex,                                                    \
@@ -43,7 +44,15 @@ namespace downpour::render {
     "rg tan(beta) and distance at k, ba at k + 1, encoded (relief.hpp)")                           \
   X(kLampMap, 18, sampler2DArray, lamp_map_tex,                                                    \
     "the lamps' light on the ground in rings around the camera, a layer per ring: rgb the "        \
-    "illuminance of an upward surface times the frame's exposure (lamp_map.hpp)")
+    "illuminance of an upward surface times the frame's exposure (lamp_map.hpp)")                  \
+  X(kEnvironmentLevels, 19, sampler2DArray, environment_levels_tex,                                \
+    "the environment probe's faces as layers, one level at a time (environment_probe.cpp)")        \
+  X(kGlassBodies, 20, samplerBuffer, glass_bodies_tex,                                             \
+    "the water's bodies on the glass, three texels each (sim::WaterBody)")                         \
+  X(kGlassCells, 21, usamplerBuffer, glass_cells_tex,                                              \
+    "per cell of the glass's grid, rows from v = 0: first entry << count bits | count "            \
+    "(sim::GlassWaterSurface)")                                                                    \
+  X(kGlassEntries, 22, usamplerBuffer, glass_entries_tex, "the cells' lists of body indices")
 
 // The per-frame uniform block: X(GLSL type, name, comment). Every field is a vec4 or a mat4, so
 // the C++ struct below has the std140 layout as it is.
@@ -76,7 +85,6 @@ namespace downpour::render {
     "side, w cell (m)")
 
 inline constexpr unsigned kFrameBlockBinding = 0;
-
 // The frame's lamps (light_set.hpp's pack_lamps), a second uniform block: per lamp four vec4s,
 //   [0] xyz position (world), w the height of the ground under it,
 //   [1] xyz the beam's axis (unit), w the cosine of its outer cone (nothing beyond),

@@ -82,7 +82,7 @@ RoadStateFractions view_road_states(const sim::ViewSpec& spec, const sim::SceneS
   }
   const sim::RoadWaterImage* image = scene.road_water.get();
   const sim::RoadNetwork& roads = scene.roads ? *scene.roads : *sim::built_in_roads();
-  const Camera camera = make_camera(spec, scene.vehicle);
+  const Camera camera = make_camera(spec, scene.vehicle, &scene.weather);
   const glm::dmat4 inverse = glm::inverse(glm::dmat4(camera.projection * camera.view));
   const glm::dvec3 eye(camera.position);
   // The road's plane under the car: its height there, level (the correction below adds the rest).

@@ -10,7 +10,7 @@ double view_wet_fraction(const sim::ViewSpec& spec, const sim::SceneState& scene
       map.rgba.size() < static_cast<std::size_t>(map.width) * map.height * 4) {
     return 0.0;
   }
-  const GlassView glass(make_camera(spec, scene.vehicle), scene.glass, spec.height);
+  const GlassView glass(make_camera(spec, scene.vehicle, &scene.weather), scene.glass, spec.height);
   constexpr int kColumns = 64, kRows = 36;
   double wet = 0.0;
   for (int row = 0; row < kRows; ++row) {

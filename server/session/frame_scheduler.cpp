@@ -11,6 +11,7 @@
 #include "server/render/atmosphere.hpp"
 #include "server/render/view_road_states.hpp"
 #include "server/render/view_wet_fraction.hpp"
+#include "server/sim/glass_water_surface.hpp"
 
 namespace downpour::session {
 namespace {
@@ -156,6 +157,8 @@ void FrameScheduler::run(std::promise<void>* started) {
     warm_scene.windshield.blades = warm_sim.state().windshield.blades;
     sim::GlassWaterMapBuilder(warm_scene.glass)
         .build(warm_scene.windshield.metaballs, warm_scene.windshield.map);
+    warm_scene.windshield.surface =
+        sim::surface_from_metaballs(warm_scene.windshield.metaballs, warm_scene.glass);
     for (const sim::View view : {sim::View::kCockpit, sim::View::kRoad, sim::View::kWindshield}) {
       const std::vector<std::uint8_t> pixels =
           render::render_image(*renderer_, sim::view_spec(view, 64, 36), warm_scene);

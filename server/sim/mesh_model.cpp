@@ -264,7 +264,9 @@ void MeshModel::move_drop(int i, double dt) {
     if (leave) drops_[i].cells_since_trail = 0;
     if (leave && trail >= w.trail_min_mass_mg) {
       set_mass(drops_[i], drops_[i].mass - trail);
+      const glm::dvec2 run = drops_[i].heading;
       const int t = new_drop(from, trail);  // may reallocate drops_
+      drops_[t].heading = run;              // the rivulet's direction (glass_water_surface.hpp)
       drops_[t].trail = true;
       drops_[t].trail_mass0 = trail;
       drops_[t].trail_radius0 = drops_[t].radius;

@@ -139,8 +139,9 @@ struct ViewSpec {
   // the driver's eye (a dash camera).
   std::optional<CameraPose> camera;
   // The lens (beyond the paper): focus distance (m) and aperture diameter (mm); absent, the view's
-  // own: the driver's eye focused on the road through a 4 mm pupil, a camera of its own focused at
-  // 3 m through 2 mm. The water on the glass blurs over its circle of confusion; 0 mm is a pinhole.
+  // own: the driver's eye focused on the road through a pupil that opens with the dark (about 2 mm
+  // by day, render::eye_pupil_mm), a camera of its own focused at 3 m through 2 mm. The water on
+  // the glass blurs over its circle of confusion; 0 mm is a pinhole.
   std::optional<double> focus_distance_m;
   std::optional<double> aperture_mm;
   // The exposure (s): a rain streak is a drop's motion during it. Absent: 1/60 s.

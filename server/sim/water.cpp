@@ -5,6 +5,8 @@
 
 #include <glm/geometric.hpp>
 
+#include "server/sim/glass_water_surface.hpp"
+
 namespace downpour::sim {
 namespace {
 
@@ -101,28 +103,86 @@ void WaterSim::release_particles(double dt, const WaterInputs& in) {
 
 void WaterSim::publish(WindshieldState& out) const {
   const WaterConfig& w = config_.water;
+  const WaterShapeConfig& shape = w.shape;
   out.metaballs.clear();
   out.metaballs.reserve(mesh_.count() * 2 + particles_.particles().size());
+  auto surface = std::make_shared<GlassWaterSurface>();
+  std::vector<WaterBody>& bodies = surface->bodies;
+  bodies.reserve(mesh_.count() * 2 + particles_.particles().size());
   auto add = [&](glm::dvec2 p, double r) {
     out.metaballs.push_back(
         {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(r)});
   };
+  // Every drop meets the glass at the same angle: its trigonometry once.
+  const WaterBody unit =
+      cap_body({0.0f, 0.0f}, 1.0f, kContactAngleDeg, true, shape.capillary_length_mm);
+  auto cap = [&](glm::dvec2 p, double r) {
+    WaterBody b = unit;
+    b.u_mm = static_cast<float>(p.x);
+    b.v_mm = static_cast<float>(p.y);
+    b.side_mm = b.front_mm = b.back_mm = static_cast<float>(r);
+    return b;
+  };
+  // Gravity along the glass, in g: what makes a resting drop sag into a tear.
+  const double along = std::cos(config_.glass.rake_deg * M_PI / 180.0);
+  const double trail_length = std::max(w.trail_spacing_cells, 1) * w.cell_mm;
+  // A rivulet's half-width grows with the root of its water per length.
+  const double width_per_root_mass = cylinder_half_width_mm(1.0, 1.0, kContactAngleDeg);
   // Life fractions in published_stages steps: trails shrink and sub-metaballs migrate stepwise.
   const double stages = std::max(w.published_stages, 1);
   auto staged = [&](double fraction) { return std::floor(fraction * stages) / stages; };
   for (const Drop& d : mesh_.drops()) {
     if (!d.alive) continue;
-    add(d.pos, d.trail ? d.trail_radius0 * (1.0 - staged(d.age / w.trail_lifetime_s)) : d.radius);
+    if (d.trail) {
+      const double left = 1.0 - staged(d.age / w.trail_lifetime_s);
+      add(d.pos, d.trail_radius0 * left);
+      // A piece of rivulet as long as the trail's spacing, holding this trail drop's water.
+      const double mass = d.trail_mass0 * left * left * left;
+      const double half_width = std::sqrt(mass / trail_length) * width_per_root_mass;
+      if (half_width > 0.05) {
+        WaterBody b = cap(d.pos, half_width);
+        b.axis_u = static_cast<float>(d.heading.x);
+        b.axis_v = static_cast<float>(d.heading.y);
+        b.half_length_mm = static_cast<float>(0.5 * trail_length);
+        b.top_mm = 0.0f;  // a thread of water: never flattened
+        bodies.push_back(b);
+      }
+      continue;
+    }
+    add(d.pos, d.radius);
+    WaterBody body = cap(d.pos, d.radius);
+    if (d.moving) {
+      // Running: a rounded front along the run, a tail behind.
+      body.axis_u = static_cast<float>(d.heading.x);
+      body.axis_v = static_cast<float>(d.heading.y);
+      body.back_mm = static_cast<float>(shape.run_back * d.radius);
+      body.side_mm = static_cast<float>(shape.run_side * d.radius);
+      add(d.pos - 0.9 * d.radius * d.heading, 0.7 * d.radius);
+    } else {
+      // Resting: sagging downhill by its Bond number along the glass.
+      const double ratio = d.radius / shape.capillary_length_mm;
+      const double bond = std::min(ratio * ratio * along, 1.0);
+      body.front_mm = static_cast<float>(d.radius * (1.0 + shape.tear_front * bond));
+      body.back_mm = static_cast<float>(d.radius * (1.0 - shape.tear_back * bond));
+    }
+    bodies.push_back(body);
     if (d.subs > 0) {
       // Impact sub-metaballs migrate into the main one as they age.
       const double offset =
           (1.0 - staged(d.sub_age / w.sub_metaball_merge_s)) * w.sub_metaball_offset * d.radius;
-      for (int k = 0; k < d.subs; ++k)
-        add(d.pos + offset * glm::dvec2(d.sub_dir[k]), w.sub_metaball_radius * d.radius);
+      for (int k = 0; k < d.subs; ++k) {
+        const glm::dvec2 at = d.pos + offset * glm::dvec2(d.sub_dir[k]);
+        add(at, w.sub_metaball_radius * d.radius);
+        bodies.push_back(cap(at, w.sub_metaball_radius * d.radius));
+      }
     }
-    if (d.moving) add(d.pos - 0.9 * d.radius * d.heading, 0.7 * d.radius);  // a running drop's tail
   }
-  for (const Particle& p : particles_.particles()) add(p.pos, drop_radius_mm(p.mass));
+  for (const Particle& p : particles_.particles()) {
+    add(p.pos, drop_radius_mm(p.mass));
+    bodies.push_back(cap(p.pos, drop_radius_mm(p.mass)));
+  }
+  surface->index(config_.glass);
+  out.surface = std::move(surface);
   out.blades = blades_;
   out.drops = mesh_.count();
   out.particles = static_cast<std::uint32_t>(particles_.particles().size());

@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -62,6 +63,20 @@ struct WiperConfig {
   // Intermittent and single wipes run at the low speed.
 };
 
+// The shapes the water takes as the light meets it (beyond seed 000: the physics of drops resting
+// on glass; glass_water_surface.hpp).
+struct WaterShapeConfig {
+  double capillary_length_mm = 2.7;  // sqrt(sigma / (rho g)) for water
+  // A resting drop sags downhill into a tear by its Bond number along the glass,
+  // B = (r / l_c)^2 cos(rake) (at most 1): its downhill reach grows by tear_front B, its uphill
+  // reach shrinks by tear_back B.
+  double tear_front = 0.25;
+  double tear_back = 0.15;
+  // A running drop: a rounded front, a tail behind reaching run_back radii, a little narrower.
+  double run_back = 1.6;
+  double run_side = 0.85;
+};
+
 // The water model's parameters (seed 000, and what this project adds).
 struct WaterConfig {
   double cell_mm = 2.0;             // mesh model cell
@@ -93,6 +108,7 @@ struct WaterConfig {
   double max_drop_diameter_mm = 6.0;
   std::uint32_t max_particles =
       20000;  // beyond this, water touched by a blade is wiped off at once
+  WaterShapeConfig shape;
 };
 
 struct WindshieldConfig {
@@ -138,8 +154,13 @@ struct GlassWaterMap {
   double coverage_at(glm::dvec2 uv_mm) const;
 };
 
+struct GlassWaterSurface;  // glass_water_surface.hpp
+
 struct WindshieldState {
   std::vector<Metaball> metaballs;  // mesh drops (main + sub-metaballs) and particles
+  // The same water as the light meets it: each body's shape (glass_water_surface.hpp); shared by
+  // copies, replaced by each publish. Null: no water to refract.
+  std::shared_ptr<const GlassWaterSurface> surface;
   std::array<BladePose, 2> blades;
   GlassWaterMap map;            // the water as every view samples it (glass_water_map.hpp)
   std::uint32_t drops = 0;      // mesh drops

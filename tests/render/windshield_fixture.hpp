@@ -12,6 +12,7 @@
 #include <tuple>
 #include <utility>
 
+#include "server/sim/glass_water_surface.hpp"
 #include "server/sim/random.hpp"
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"
@@ -40,6 +41,33 @@ inline sim::SceneState highway_scene(double rain_mm_h = 25.0, double cloudiness 
   return simulated.emplace(key, simulation.state()).first->second;
 }
 
+// The highway's car parked (at its place 10 s into the drive) with the wipers off, `seconds` of
+// rain at `rain_mm_h` on the glass, the sun `sun_altitude_deg` high under `cloudiness`; at night
+// (the sun well below the horizon) the street lights and the car's own lamps are on. The rain in
+// the air is left out: these scenes measure the glass. Simulated once per set of inputs and kept.
+inline sim::SceneState parked_in_rain(double rain_mm_h, double seconds, double sun_altitude_deg,
+                                      double cloudiness) {
+  static std::map<std::tuple<double, double, double, double>, sim::SceneState> simulated;
+  const std::tuple key(rain_mm_h, seconds, sun_altitude_deg, cloudiness);
+  const auto it = simulated.find(key);
+  if (it != simulated.end()) return it->second;
+  const sim::Scenario scenario = sim::highway_heavy_rain();
+  sim::Update update = scenario.at(10.0);
+  update.vehicle->velocity_mps = glm::dvec3(0.0);
+  update.wipers = sim::WiperState{};  // off
+  update.weather->rain_rate_mm_h = rain_mm_h;
+  update.weather->sun_altitude_deg = sun_altitude_deg;
+  update.weather->cloudiness = cloudiness;
+  update.traffic = std::vector<sim::TrafficVehicle>{};
+  sim::Simulation simulation(scenario.seed, update);
+  simulation.advance(seconds);
+  sim::SceneState scene = simulation.state();
+  scene.rain.drops.clear();
+  scene.rain.splashes.clear();
+  scene.spray.reset();
+  return simulated.emplace(key, scene).first->second;
+}
+
 // A blade of the default wipers (sim::WiperConfig) at an angle from +u, degrees.
 inline sim::BladePose blade_at(int index, double angle_deg) {
   const sim::BladeConfig c = sim::WiperConfig{}.blades[index];
@@ -56,9 +84,11 @@ inline std::array<sim::BladePose, 2> parked_blades() {
   return {blade_at(0, w.blades[0].park_deg), blade_at(1, w.blades[1].park_deg)};
 }
 
-// The glass water map of the metaballs, as the simulation publishes it (its own builder).
+// The glass water map of the metaballs, as the simulation publishes it (its own builder), and
+// their surface: a round cap each.
 inline void build_water_map(sim::WindshieldState& state, const sim::GlassConfig& glass) {
   sim::GlassWaterMapBuilder(glass).build(state.metaballs, state.map);
+  state.surface = sim::surface_from_metaballs(state.metaballs, glass);
   state.glass_wet_fraction = state.map.wet_fraction;
 }
 

@@ -3,71 +3,64 @@
 #include <algorithm>
 #include <cmath>
 
-#include "server/render/light_set.hpp"
-#include "server/render/passes/lamp_glow_pass.hpp"
+#include "server/render/atmosphere.hpp"
+#include "server/sim/glass_water_surface.hpp"
 
 namespace downpour::render {
 
-GlassWaterPass::GlassWaterPass(SharedResources&, GlassWaterConfig config)
-    : config_(config),
-      program_("glass.vert", "glass_water.frag"),
-      quad_(program_),
-      u_map_size_mm_(program_.uniform("u_map_size_mm")),
-      u_taps_(program_.uniform("u_taps")),
-      u_inv_target_(program_.uniform("u_inv_target")),
-      u_screen_axes_(program_.uniform("u_screen_axes")),
-      u_refraction_(program_.uniform("u_refraction")),
-      u_lamp_count_(program_.uniform("u_lamp_count")),
-      u_lamps_(program_.uniform("u_lamps")) {
-  program_.uniform("u_water_ior").set(config_.water_ior);
-  program_.uniform("u_fresnel_r0").set(config_.fresnel_r0);
-  program_.uniform("u_rim_darkening").set(config_.rim_darkening);
-  program_.uniform("u_rim_lean").set(glm::vec2(config_.rim_lean[0], config_.rim_lean[1]));
-  program_.uniform("u_glint").set(config_.sun_glint);
-  program_.uniform("u_lamp_spread")
-      .set(glm::vec2(std::cos(config_.lamp_spread_rad[0]), std::cos(config_.lamp_spread_rad[1])));
-  lamps_.reserve(2 * kGlassLamps + 2);  // an insertion before the list is cut back
+glm::vec3 cabin_radiance(const Atmosphere& atmosphere, const GlassWaterConfig& config) {
+  return atmosphere.ambient * config.cabin_per_ambient;
 }
 
+GlassWaterPass::Optics::Optics(const char* fragment_file, const GlassWaterConfig& config)
+    : program(std::make_unique<ShaderProgram>("glass.vert", fragment_file)),
+      quad(*program),
+      cells(program->uniform("u_cells")),
+      env_per_rad(program->uniform("u_env_per_rad")),
+      env_max_lod(program->uniform("u_env_max_lod")),
+      env_from_world(program->uniform("u_env_from_world")),
+      cabin(program->uniform("u_cabin")),
+      glass_depth(program->uniform("u_glass_depth")),
+      view_pixel_rad(program->uniform("u_view_pixel_rad")),
+      inv_target(program->uniform("u_inv_target")),
+      inv_view(program->uniform("u_inv_view")),
+      samples(program->uniform("u_samples")) {
+  program->uniform("u_water_ior").set(config.water_ior);
+  program->uniform("u_cell_mm").set(static_cast<float>(sim::GlassWaterSurface::kCellMm));
+  program->uniform("u_count_bits").set(static_cast<unsigned>(sim::GlassWaterSurface::kCountBits));
+}
+
+GlassWaterPass::GlassWaterPass(SharedResources&, GlassWaterConfig config)
+    : config_(config),
+      sharp_("glass_water.frag", config_),
+      blurred_("glass_water_blurred.frag", config_) {}
+
 bool GlassWaterPass::wanted(const FrameContext& frame) const {
+  // (The blades alone still need the glass layer, which this pass makes: the composite draws them.)
   return glass_has_water_or_blades(frame.water());
 }
 
 void GlassWaterPass::execute(const FrameContext& frame, const FrameResources& resources) {
-  const sim::GlassWaterMap& map = frame.water().map;
-  program_.use();
-  u_map_size_mm_.set(map_size_mm(map, frame.scene.glass));
-  u_taps_.set(frame.glass.layer_scale() > 1 ? 4 : 1);
-  u_inv_target_.set(1.0f / glm::vec2(resources.glass_layer.width, resources.glass_layer.height));
-  u_screen_axes_.set(frame.glass.screen_axes());
-  // Screen offset of the lookup per unit of the deflection angle's tangent: the focal length in
-  // uv units of the view (the image's size and field of view).
-  const float focal = frame.camera.projection[1][1];
-  const float aspect = static_cast<float>(frame.spec.width) / static_cast<float>(frame.spec.height);
-  u_refraction_.set(0.5f * glm::vec2(focal / aspect, focal));
-  // The strongest glares (by insertion: kGlassLamps is small), each as a direction from the eye
-  // towards the lamp and the radiance its drops show.
-  lamps_.clear();
-  if (frame.lights) {
-    constexpr float kLeast = 0.002f;  // under 1% of white through a drop
-    for (const Light& l : *frame.lights) {
-      glm::vec3 to_camera;
-      const float glare = lamp_glare(l, frame.camera.position, frame.atmosphere.lux_exposure,
-                                     frame.atmosphere.fog_density, &to_camera);
-      if (glare < kLeast) continue;
-      const glm::vec4 lamp(-to_camera, glare * config_.lamp_scatter);
-      const float peak = std::max({l.intensity_cd.r, l.intensity_cd.g, l.intensity_cd.b});
-      const glm::vec4 colour(l.intensity_cd / peak, 0.0f);
-      std::size_t at = lamps_.size();
-      while (at > 0 && lamps_[at - 2].w < lamp.w) at -= 2;
-      if (at >= 2 * kGlassLamps) continue;
-      lamps_.insert(lamps_.begin() + static_cast<std::ptrdiff_t>(at), {lamp, colour});
-      if (lamps_.size() > 2 * kGlassLamps) lamps_.resize(2 * kGlassLamps);
-    }
-  }
-  u_lamp_count_.set(static_cast<int>(lamps_.size() / 2));
-  if (!lamps_.empty()) u_lamps_.set(lamps_.data(), static_cast<int>(lamps_.size()));
-  quad_.draw(frame);  // also the glass's axes, for the refracted rays
+  const sim::GlassWaterSurface* surface = frame.water().surface.get();
+  const int scale = std::clamp(frame.glass.layer_scale(), 1, 4);
+  const Optics& o = scale > 1 ? blurred_ : sharp_;
+  o.program->use();
+  o.cells.set(surface ? glm::ivec2(surface->cells_u, surface->cells_v) : glm::ivec2(0));
+  const int face = std::max(resources.environment.width, 1);
+  o.env_per_rad.set(0.5f * static_cast<float>(face));
+  // No coarser than 8 x 8 texels a face (11 degrees each): a ray's light comes from around its own
+  // direction, not from a whole face (the sun behind the car would light every grazing ray).
+  o.env_max_lod.set(std::max(std::log2(static_cast<float>(face)) - 3.0f, 0.0f));
+  o.env_from_world.set(glm::mat4(resources.environment_from_world));
+  o.cabin.set(cabin_radiance(frame.atmosphere, config_));
+  o.glass_depth.set(frame.glass.depth_over_image());
+  o.view_pixel_rad.set(2.0f * static_cast<float>(frame.camera.tan_half_fov_y) /
+                       static_cast<float>(std::max(frame.spec.height, 1)));
+  const int samples = config_.samples_by_scale[scale - 1];
+  o.samples.set(samples >= 16 ? 16 : samples >= 4 ? 4 : 2);
+  o.inv_target.set(1.0f / glm::vec2(resources.glass_layer.width, resources.glass_layer.height));
+  o.inv_view.set(1.0f / glm::vec2(resources.view_colour.width, resources.view_colour.height));
+  o.quad.draw(frame);  // also the glass's axes, for the rays' frame
 }
 
 }  // namespace downpour::render

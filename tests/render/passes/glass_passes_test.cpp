@@ -106,7 +106,9 @@ TEST_F(GlassPassesTest, DropsRefractWhereTheyLieAndNowhereElse) {
 
 // The simulation's water: heavy rain at 25 m/s with the wipers off for 4 s, then one wipe. In the
 // cockpit image, a square of glass inside blade 0's swept sector is closer to the dry-glass image
-// after the wipe than a square above the reach of both blades.
+// after the wipe than the same square is at the same time without the wipe, and than it was before
+// it. (The same square in both: through traced lenses a drop changes what lies behind it by that
+// scene's contrast, so squares over different parts of the scene do not compare.)
 TEST_F(GlassPassesTest, AfterAWipeTheSweptSectorLooksLikeDryGlass) {
   const sim::Scenario scenario = sim::highway_heavy_rain();
   sim::Update update = scenario.at(10.0);
@@ -114,13 +116,16 @@ TEST_F(GlassPassesTest, AfterAWipeTheSweptSectorLooksLikeDryGlass) {
   sim::Simulation simulation(scenario.seed, update);
   simulation.advance(4.0);
   const sim::WindshieldState before = simulation.state().windshield;
+  sim::Simulation unwiped = simulation;
   update.wipers = sim::WiperState{sim::WiperMode::kSingle, 4.0, {}};
   simulation.apply(update);
   simulation.advance(1.6);  // a cycle at 45 per minute takes 1.33 s
+  unwiped.advance(1.6);
   const sim::WindshieldState after = simulation.state().windshield;
 
   const sim::ViewSpec spec = view_spec(sim::View::kCockpit, 640, 360);
   const RgbaImage dry = render({}, spec), wet = render(before, spec), wiped = render(after, spec);
+  const RgbaImage left = render(unwiped.state().windshield, spec);
   save_if_asked("cockpit_before_wipe.png", wet);
   save_if_asked("cockpit_after_wipe.png", wiped);
   const sim::WiperConfig wipers;
@@ -128,19 +133,17 @@ TEST_F(GlassPassesTest, AfterAWipeTheSweptSectorLooksLikeDryGlass) {
   const double angle = (blade.park_deg + 0.5 * blade.sweep_deg) * M_PI / 180.0;
   const glm::dvec2 swept =
       glm::dvec2(blade.pivot_mm) + 420.0 * glm::dvec2(std::cos(angle), std::sin(angle));
-  const glm::dvec2 unswept(760.0, 730.0);  // above both blades' reach
-  const auto change = [&](const RgbaImage& image, glm::dvec2 centre) {
-    const glm::ivec4 box = glass_box(centre, 30.0, spec);
+  const auto change = [&](const RgbaImage& image) {
+    const glm::ivec4 box = glass_box(swept, 30.0, spec);
     EXPECT_GT(box.z - box.x, 10);
     EXPECT_GT(box.w - box.y, 4);
     return difference(image, dry, box.x, box.y, box.z, box.w);
   };
-  // Both squares are wet before the wipe; after it the swept one is much closer to dry glass
-  // (mean RGB difference to the dry image, 0..255).
-  EXPECT_GT(change(wet, swept), 1.0);
-  EXPECT_GT(change(wet, unswept), 1.0);
-  EXPECT_LT(change(wiped, swept), 0.75 * change(wiped, unswept));  // measured 0.70 and 1.51
-  EXPECT_LT(change(wiped, swept), 0.6 * change(wet, swept));       // 1.78 before (fresh rain since)
+  // Mean RGB difference to the dry image, 0..255: measured 5.70 before the wipe, 3.41 after it
+  // (fresh rain since), and 4.64 without it.
+  EXPECT_GT(change(wet), 1.0);
+  EXPECT_LT(change(wiped), 0.75 * change(left));
+  EXPECT_LT(change(wiped), 0.75 * change(wet));
 }
 
 TEST_F(GlassPassesTest, ClearGlassLeavesTheScene) {

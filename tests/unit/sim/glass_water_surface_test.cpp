@@ -1,0 +1,151 @@
+// The water's surface as the light meets it (glass_water_surface.hpp): the shapes of sessile drops
+// (a cap's height from its contact angle, the flat top of a wide body, a rivulet's width from its
+// water), the grid that lists every body wherever its outline reaches, and the shapes the
+// simulation publishes (tears downhill, running drops with a tail, trails as cylinders holding
+// their water).
+#include "server/sim/glass_water_surface.hpp"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <glm/geometric.hpp>
+
+#include "server/sim/drop_physics.hpp"
+#include "server/sim/random.hpp"
+#include "server/sim/water.hpp"
+
+namespace downpour::sim {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// rho^2 at p for a body, as its fields define its outline (glass_water_surface.hpp).
+double rho2(const WaterBody& b, glm::dvec2 p) {
+  const glm::dvec2 d = p - glm::dvec2(b.u_mm, b.v_mm);
+  double x = d.x * b.axis_u + d.y * b.axis_v;
+  const double y = -d.x * b.axis_v + d.y * b.axis_u;
+  x -= std::clamp(x, -static_cast<double>(b.half_length_mm), static_cast<double>(b.half_length_mm));
+  const double ax = x >= 0.0 ? b.front_mm : b.back_mm;
+  return (x / ax) * (x / ax) + (y / b.side_mm) * (y / b.side_mm);
+}
+
+bool listed(const GlassWaterSurface& s, std::size_t body, glm::dvec2 p) {
+  const int i = static_cast<int>(std::floor(p.x / GlassWaterSurface::kCellMm));
+  const int j = static_cast<int>(std::floor(p.y / GlassWaterSurface::kCellMm));
+  if (i < 0 || j < 0 || i >= s.cells_u || j >= s.cells_v) return false;
+  const std::uint32_t cell = s.cells[static_cast<std::size_t>(j) * s.cells_u + i];
+  const std::uint32_t first = cell >> GlassWaterSurface::kCountBits;
+  const std::uint32_t count = cell & ((1u << GlassWaterSurface::kCountBits) - 1);
+  for (std::uint32_t k = first; k < first + count; ++k) {
+    if (s.entries[k] == body) return true;
+  }
+  return false;
+}
+
+TEST(GlassWaterSurfaceTest, ACapRisesToItsContactAnglesHeight) {
+  // A spherical cap of contact radius a meeting the glass at q: R = a / sin q, height a tan(q/2),
+  // as the body's fields give it: a (sqrt(1 / sin^2) - cot) at its centre.
+  for (const double q : {40.0, 70.0, 90.0}) {
+    const WaterBody b = cap_body({100.0f, 100.0f}, 1.5f, q, false);
+    const double height = 1.5 * (std::sqrt(b.inv_sin2) - b.cot);
+    const double expected = q < 87.0 ? 1.5 * std::tan(0.5 * q * kDeg) : 1.5 * std::tan(43.5 * kDeg);
+    EXPECT_NEAR(height, expected, 1e-5) << q;
+    EXPECT_EQ(b.top_mm, 0.0f);
+  }
+  // A wide body's flat top: 2 l_c sin(q / 2), 1.85 mm for water at 40 degrees.
+  EXPECT_NEAR(puddle_thickness_mm(40.0), 1.847, 1e-3);
+  EXPECT_NEAR(cap_body({0.0f, 0.0f}, 6.0f, 40.0).top_mm, 1.847f, 1e-3f);
+}
+
+TEST(GlassWaterSurfaceTest, ARivuletHoldsItsWater) {
+  // A cylinder's cross-section is a circular segment of area w^2 (q - sin q cos q) / sin^2 q.
+  const double w = cylinder_half_width_mm(0.9, 6.0, 40.0);
+  const double q = 40.0 * kDeg;
+  const double area = w * w * (q - std::sin(q) * std::cos(q)) / (std::sin(q) * std::sin(q));
+  EXPECT_NEAR(area * 6.0, 0.9, 1e-9);
+  EXPECT_GT(w, 0.4);  // a thread of water about a millimetre wide
+  EXPECT_LT(w, 0.7);
+}
+
+TEST(GlassWaterSurfaceTest, EveryPointOfABodyIsListedInItsCell) {
+  const GlassConfig glass;
+  GlassWaterSurface surface;
+  RandomStream random(3, 0);
+  for (int k = 0; k < 400; ++k) {
+    const glm::vec2 at(static_cast<float>(random.uniform(20.0, 1500.0)),
+                       static_cast<float>(random.uniform(20.0, 740.0)));
+    WaterBody b = k % 3 == 2
+                      ? cylinder_body(at, glm::normalize(glm::vec2(0.3f, -1.0f)), 0.5f, 3.0f, 40.0)
+                      : cap_body(at, static_cast<float>(random.uniform(0.3, 6.0)), 40.0);
+    if (k % 3 == 1) {  // a tear or a running drop
+      b.axis_u = 0.6f, b.axis_v = -0.8f;
+      b.front_mm *= 1.2f, b.back_mm *= 1.6f, b.side_mm *= 0.85f;
+    }
+    surface.bodies.push_back(b);
+  }
+  surface.index(glass);
+  int inside = 0;
+  for (std::size_t k = 0; k < surface.bodies.size(); ++k) {
+    const WaterBody& b = surface.bodies[k];
+    const double reach = body_reach_mm(b);
+    for (int n = 0; n < 200; ++n) {
+      const glm::dvec2 p = glm::dvec2(b.u_mm, b.v_mm) +
+                           glm::dvec2(random.uniform(-reach, reach), random.uniform(-reach, reach));
+      if (rho2(b, p) >= 1.0 || p.x < 0.0 || p.y < 0.0) continue;
+      ++inside;
+      ASSERT_TRUE(listed(surface, k, p)) << "body " << k << " at (" << p.x << ", " << p.y << ")";
+    }
+  }
+  EXPECT_GT(inside, 20000);
+  // And a cell lists only bodies that come near it: far from all of them, none. A drop as wide as
+  // a cell, at a cell's centre, reaches the 3 x 3 cells round it.
+  const float c = static_cast<float>(GlassWaterSurface::kCellMm);
+  GlassWaterSurface one;
+  one.bodies.push_back(cap_body({50.5f * c, 50.5f * c}, c, 40.0));
+  one.index(glass);
+  EXPECT_TRUE(listed(one, 0, {50.5 * c, 50.5 * c}));
+  EXPECT_FALSE(listed(one, 0, {53.0 * c, 50.5 * c}));
+  EXPECT_EQ(one.entries.size(), 9u);
+}
+
+TEST(GlassWaterSurfaceTest, TheSimulationPublishesDropsTearsRunsAndTrails) {
+  WindshieldConfig config;
+  WaterSim water(config, 11);
+  // A small drop, one wider than the capillary length, and one big enough to run down the glass.
+  water.add_drop({300.0, 400.0}, drop_mass_mg(0.8));
+  water.add_drop({700.0, 400.0}, drop_mass_mg(2.1));
+  water.add_drop({1100.0, 600.0}, drop_mass_mg(4.0));
+  WaterInputs in;
+  for (int b = 0; b < 2; ++b) {
+    const BladeConfig& c = config.wipers.blades[b];
+    in.blades_before[b] =
+        in.blades_after[b] = {glm::vec2(c.pivot_mm), static_cast<float>(c.park_deg * kDeg),
+                              static_cast<float>(c.length_mm), static_cast<float>(c.width_mm)};
+  }
+  for (int i = 0; i < 60; ++i) water.step(1.0 / 60.0, in);
+  WindshieldState state;
+  water.publish(state);
+  ASSERT_TRUE(state.surface);
+  const GlassWaterSurface& s = *state.surface;
+  int tears = 0, runs = 0, trails = 0, drops = 0;
+  for (const WaterBody& b : s.bodies) {
+    if (b.half_length_mm > 0.0f) {
+      ++trails;
+      EXPECT_EQ(b.side_mm, b.front_mm) << "a cylinder: round across";
+      continue;
+    }
+    ++drops;
+    if (b.back_mm > b.front_mm) ++runs;           // a tail behind its run
+    if (b.front_mm > 1.05f * b.back_mm) ++tears;  // heavier downhill
+  }
+  EXPECT_EQ(drops, static_cast<int>(water.drop_count()) - trails);
+  EXPECT_GE(runs, 1) << "the big drop runs with a tail";
+  EXPECT_GE(tears, 1) << "the wide resting drop sags downhill";
+  EXPECT_GE(trails, 1) << "the running drop leaves a rivulet";
+  // Every body listed where it is.
+  for (std::size_t k = 0; k < s.bodies.size(); ++k)
+    EXPECT_TRUE(listed(s, k, {s.bodies[k].u_mm, s.bodies[k].v_mm}));
+}
+
+}  // namespace
+}  // namespace downpour::sim
