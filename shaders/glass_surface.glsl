@@ -25,10 +25,9 @@ Body body_at(uint k) {
 }
 
 // A body's outline through p: rho (the fraction of the way out from its centre line to its
-// outline, along the line through p), r (the outline's distance that way, mm) and the gradient
-// of rho over the glass.
+// outline, along the line through p) and its gradient over the glass.
 struct Outline {
-  float rho, r;
+  float rho;
   vec2 drho;
 };
 Outline body_outline(vec4 place, vec4 reach, vec2 p) {
@@ -37,11 +36,9 @@ Outline body_outline(vec4 place, vec4 reach, vec2 p) {
   x -= clamp(x, -reach.w, reach.w);  // a cylinder's own length is flat along it
   vec2 half_axes = vec2(x >= 0.0 ? reach.y : reach.z, reach.x);
   float rho = length(vec2(x, y) / half_axes);
-  // At the centre line itself any direction's r will do: its across reach.
-  float r = rho > 1e-6 ? length(vec2(x, y)) / rho : half_axes.y;
   vec2 drho = (along * (x / (half_axes.x * half_axes.x)) +
                across * (y / (half_axes.y * half_axes.y))) / max(rho, 1e-5);
-  return Outline(rho, r, drho);
+  return Outline(rho, drho);
 }
 
 // The square of a body's rho at p (body_outline's), for the search through a cell's bodies.
@@ -53,16 +50,17 @@ float body_rho2(vec4 place, vec4 reach, vec2 p) {
   return dot(q, q);
 }
 
-// One body's surface over p: its profile along the line from its centre line out through p, a
-// fraction rho of the way to its outline there (which lies r mm out): a spherical cap meeting the
-// glass at the contact angle, r (sqrt(1 / sin^2 - rho^2) - cot); where flattened, a smooth minimum
-// with a flat top t mm thick that the edge reaches over some capillary lengths,
-// t (1 - exp(-x tan / t)) at x mm in from the edge; beyond the outline, on down at the contact
-// angle (so that a Newton step that overshoots the edge comes back).
+// One body's surface over p, a fraction rho of the way out from its centre line to its outline:
+// the profile of a cap of radius r (its reach across: a round drop's radius) meeting the glass at
+// the contact angle, r (sqrt(1 / sin^2 - rho^2) - cot), stretched to the outline (a longer body
+// meets the glass less steeply at its ends); where flattened, a smooth minimum with a flat top t mm
+// thick that the edge reaches over some capillary lengths, t (1 - exp(-x tan / t)) at x = r
+// (1 - rho) mm in from the edge; beyond the outline, on down at the contact angle (so that a Newton
+// step that overshoots the edge comes back).
 WaterSurface body_surface(Body b, vec2 p) {
   vec4 angle = b.angle;
   Outline o = body_outline(b.place, b.reach, p);
-  float rho = o.rho, r = o.r;
+  float rho = o.rho, r = b.reach.x;
   float inv_sin2 = angle.x, cot = angle.y, tn = angle.z, top = angle.w;
   // Height and its first two derivatives in rho.
   float h, dh, d2h;
@@ -89,22 +87,22 @@ WaterSurface body_surface(Body b, vec2 p) {
   return WaterSurface(h, dh * o.drho, abs(d2h) / (r * r * g * sqrt(g)));
 }
 
-// Whether glass point p lies under water, and the body it lies deepest within (the fraction of
-// the way out to its outline least), whose surface the light meets there: of the bodies listed in
-// p's cell.
+// Whether glass point p lies under water, and the body that rises highest there, whose surface
+// the light meets: of the bodies listed in p's cell, those whose outline holds p, by their cap's
+// height there, about r (1 - rho^2) (a sub-metaball near a drop's centre stays under it).
 bool water_top(vec2 p, out uint top) {
   top = 0u;
   ivec2 cell = ivec2(floor(p / u_cell_mm));
   if (any(lessThan(cell, ivec2(0))) || any(greaterThanEqual(cell, u_cells))) return false;
   uint listing = texelFetch(glass_cells_tex, cell.y * u_cells.x + cell.x).r;
   uint first = listing >> u_count_bits, count = listing & ((1u << u_count_bits) - 1u);
-  float least = 1.0;
+  float highest = 0.0;
   for (uint i = 0u; i < count; ++i) {
     uint k = texelFetch(glass_entries_tex, int(first + i)).r;
-    float rho2 = body_rho2(texelFetch(glass_bodies_tex, 3 * int(k)),
-                           texelFetch(glass_bodies_tex, 3 * int(k) + 1), p);
-    top = rho2 < least ? k : top;
-    least = min(least, rho2);
+    vec4 reach = texelFetch(glass_bodies_tex, 3 * int(k) + 1);
+    float height = reach.x * (1.0 - body_rho2(texelFetch(glass_bodies_tex, 3 * int(k)), reach, p));
+    top = height > highest ? k : top;
+    highest = max(highest, height);
   }
-  return least < 1.0;
+  return highest > 0.0;
 }

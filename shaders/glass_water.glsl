@@ -65,7 +65,9 @@ vec3 through_water(vec2 p, uint top, vec3 w, float spacing, mat3 dir_of) {
     s = body_surface(body, p + t * w.xy);
   }
   vec3 n = normalize(vec3(-s.slope, 1.0));
-  float ci = dot(w, n);  // cosine inside the water, leaving
+  // Cosine inside the water, leaving (a Newton step that ends on the far side of a steep edge may
+  // see the surface from behind: taken as grazing).
+  float ci = max(dot(w, n), 1e-3);
   float k = 1.0 - u_water_ior * u_water_ior * (1.0 - ci * ci);
   // Reflected inside: down through the glass into the cabin, unless too oblique to leave it.
   vec3 r = reflect(w, n);

@@ -30,9 +30,8 @@ constexpr float kNearM = 0.05f;
 
 }  // namespace
 
-EnvironmentProbe::EnvironmentProbe(EnvironmentConfig config)
-    : config_(config),
-      resolve_("fullscreen.vert", "environment_resolve.frag"),
+EnvironmentPrograms::EnvironmentPrograms()
+    : resolve_("fullscreen.vert", "environment_resolve.frag"),
       u_face_(resolve_.uniform("u_face")),
       u_texel_rad_(resolve_.uniform("u_texel_rad")),
       u_sun_energy_(resolve_.uniform("u_sun_energy")),
@@ -40,6 +39,14 @@ EnvironmentProbe::EnvironmentProbe(EnvironmentConfig config)
       u_lamp_texel_rad_(lamps_.uniform("u_texel_rad")),
       level_("fullscreen.vert", "environment_level.frag"),
       u_layer_(level_.uniform("u_layer")) {
+  GLuint vao = 0;
+  glCreateVertexArrays(1, &vao);
+  empty_vao_ = VertexArray(vao);
+  // A lookup near a face's edge filters across into its neighbour.
+  glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+}
+
+EnvironmentProbe::EnvironmentProbe(EnvironmentConfig config) : config_(config) {
   const int size = config_.face_size;
   if (size < 4 || size > 2048) throw std::invalid_argument("environment face size out of range");
   for (int s = size; s > 1; s /= 2) ++levels_;
@@ -63,14 +70,8 @@ EnvironmentProbe::EnvironmentProbe(EnvironmentConfig config)
   resolve_fbo_ = Framebuffer(fbos[1]);
   glNamedFramebufferTexture(fbos[0], GL_COLOR_ATTACHMENT0, face_colour_.id(), 0);
   glNamedFramebufferTexture(fbos[0], GL_DEPTH_ATTACHMENT, face_depth_.id(), 0);
-  glNamedFramebufferTexture(fbos[1], GL_DEPTH_ATTACHMENT, face_depth_.id(), 0);
   if (glCheckNamedFramebufferStatus(fbos[0], GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
     throw std::runtime_error("environment face framebuffer incomplete");
-  GLuint vao = 0;
-  glCreateVertexArrays(1, &vao);
-  empty_vao_ = VertexArray(vao);
-  // A lookup near a face's edge filters across into its neighbour.
-  glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
 }
 
 glm::vec3 EnvironmentProbe::direction(int face, glm::vec2 xy) {
@@ -99,8 +100,8 @@ glm::mat3 EnvironmentProbe::from_world(const glm::mat4& vehicle_to_world) const 
   return fixed_ ? glm::mat3(1.0f) : glm::transpose(glm::mat3(vehicle_to_world));
 }
 
-void EnvironmentProbe::resolve(int face, const glm::mat3& axes, const Atmosphere& atmosphere,
-                               int lamps) {
+void EnvironmentProbe::resolve(const EnvironmentPrograms& p, int face, const glm::mat3& axes,
+                               const Atmosphere& atmosphere, int lamps) {
   const GLuint fbo = resolve_fbo_.id();
   glNamedFramebufferTextureLayer(fbo, GL_COLOR_ATTACHMENT0, cube_.id(), 0, face);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
@@ -111,22 +112,25 @@ void EnvironmentProbe::resolve(int face, const glm::mat3& axes, const Atmosphere
   glDepthMask(GL_FALSE);
   glDisable(GL_BLEND);
   const FaceAxes& a = kFaceAxes.at(static_cast<std::size_t>(face));
-  resolve_.use();
-  u_face_.set(glm::mat4(axes * glm::mat3(glm::cross(a.forward, a.up), a.up, a.forward)));
+  p.resolve_.use();
+  p.u_face_.set(glm::mat4(axes * glm::mat3(glm::cross(a.forward, a.up), a.up, a.forward)));
   const float texel_rad = 2.0f / static_cast<float>(config_.face_size);
-  u_texel_rad_.set(texel_rad);
+  p.u_texel_rad_.set(texel_rad);
   // Irradiance, in the radiance a white card facing it shows (times pi): the sun's disc, less the
   // cloud that hides it.
-  u_sun_energy_.set(atmosphere.sun_radiance * static_cast<float>(M_PI) *
-                    (1.0f - atmosphere.overcast));
-  glBindVertexArray(empty_vao_.id());
+  p.u_sun_energy_.set(atmosphere.sun_radiance * static_cast<float>(M_PI) *
+                      (1.0f - atmosphere.overcast));
+  glBindVertexArray(p.empty_vao_.id());
   glDrawArrays(GL_TRIANGLES, 0, 3);
 
   // The lamps: each a spot a texel wide holding its light at the probe, hidden by what stands in
   // front of it.
   if (lamps > 0) {
-    lamps_.use();
-    u_lamp_texel_rad_.set(texel_rad);
+    // Their depth test against the face's depth (attached for this draw alone: the resolve above
+    // reads it).
+    glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, face_depth_.id(), 0);
+    p.lamps_.use();
+    p.u_lamp_texel_rad_.set(texel_rad);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GEQUAL);
     glEnable(GL_BLEND);
@@ -136,20 +140,20 @@ void EnvironmentProbe::resolve(int face, const glm::mat3& axes, const Atmosphere
     glDisable(GL_PROGRAM_POINT_SIZE);
     glDisable(GL_BLEND);
     glDisable(GL_DEPTH_TEST);
+    glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, 0, 0);
   }
   glDepthMask(GL_TRUE);
-  make_levels(face);
+  make_levels(p, face);
 }
 
 // A face's mip levels, each texel the mean of the four under it (glGenerateMipmap would redo all
 // six faces, and costs llvmpipe some milliseconds at that).
-void EnvironmentProbe::make_levels(int face) {
+void EnvironmentProbe::make_levels(const EnvironmentPrograms& p, int face) {
   const GLuint fbo = resolve_fbo_.id();
-  glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, 0, 0);
-  level_.use();
-  u_layer_.set(face);
+  p.level_.use();
+  p.u_layer_.set(face);
   glBindTextureUnit(texture_unit::kEnvironmentLevels, levels_view_.id());
-  glBindVertexArray(empty_vao_.id());
+  glBindVertexArray(p.empty_vao_.id());
   for (int level = 1; level < levels_; ++level) {
     // Read the level above alone (no loop between the level read and the level written).
     glTextureParameteri(levels_view_.id(), GL_TEXTURE_BASE_LEVEL, level - 1);
@@ -162,7 +166,6 @@ void EnvironmentProbe::make_levels(int face) {
   }
   glTextureParameteri(levels_view_.id(), GL_TEXTURE_BASE_LEVEL, 0);
   glTextureParameteri(levels_view_.id(), GL_TEXTURE_MAX_LEVEL, levels_ - 1);
-  glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, face_depth_.id(), 0);
 }
 
 std::vector<EnvironmentProbe::Due> EnvironmentProbe::faces_due(double time_s, bool complete) {
@@ -171,12 +174,13 @@ std::vector<EnvironmentProbe::Due> EnvironmentProbe::faces_due(double time_s, bo
   if (!drawn_) {
     for (int f = 0; f < kFaces; ++f) due.push_back({f, complete || f == 0});
     drawn_ = true;
+    tick_ = 1;  // the front's next turn comes after the others' first
   } else if (time_s != last_time_s_) {
-    // Every ticks_per_face ticks a face: the front (+x) every other time; between, the left,
-    // right, sky and ground in turn.
+    // Every ticks_per_face ticks a face: the front (+x) every other time; between, the ground
+    // (the bonnet and the road, which most drops show at their top), left, right and sky in turn.
     const int every = std::max(config_.ticks_per_face, 1);
     if (tick_ % every == 0) {
-      constexpr int kBetween[] = {2, 3, 4, 5};
+      constexpr int kBetween[] = {5, 2, 3, 4};
       const int turn = tick_ / every;
       due.push_back({turn % 2 == 0 ? 0 : kBetween[(turn / 2) % 4], true});
     }

@@ -35,6 +35,22 @@ struct EnvironmentConfig {
   float clearance_m = 0.05f;
 };
 
+// The programs that make a probe's faces: compiled once, for every session's probe.
+class EnvironmentPrograms {
+ public:
+  EnvironmentPrograms();
+
+ private:
+  friend class EnvironmentProbe;
+  ShaderProgram resolve_;
+  Uniform u_face_, u_texel_rad_, u_sun_energy_;
+  ShaderProgram lamps_;
+  Uniform u_lamp_texel_rad_;
+  ShaderProgram level_;
+  Uniform u_layer_;
+  VertexArray empty_vao_;
+};
+
 class EnvironmentProbe {
  public:
   static constexpr int kFaces = 6;
@@ -65,7 +81,8 @@ class EnvironmentProbe {
   // ground, less the overcast that hides it) and the first `lamps` lamps of the lamp block (their
   // light at the probe, under the frame's exposure and haze), then makes that face's mip levels.
   // The frame block must hold the face's camera; `axes` as for face_camera.
-  void resolve(int face, const glm::mat3& axes, const Atmosphere& atmosphere, int lamps);
+  void resolve(const EnvironmentPrograms& programs, int face, const glm::mat3& axes,
+               const Atmosphere& atmosphere, int lamps);
 
   // The refresh's bookkeeping: the faces that a tick at `time_s` draws (none again within the same
   // tick), in order, and whether each shows the world or the sky alone. The first time, all six:
@@ -82,22 +99,15 @@ class EnvironmentProbe {
   bool fixed() const { return fixed_; }
 
  private:
+  void make_levels(const EnvironmentPrograms& programs, int face);
+
   EnvironmentConfig config_;
   int levels_ = 1;
-  void make_levels(int face);
-
   Texture cube_;
-  Texture
-      levels_view_;  // the cube as six layers, for reading one face's level while writing the next
+  // The cube as six layers, for reading one face's level while writing the next.
+  Texture levels_view_;
   Texture face_colour_, face_depth_;
   Framebuffer face_fbo_, resolve_fbo_;
-  ShaderProgram resolve_;
-  Uniform u_face_, u_texel_rad_, u_sun_energy_;
-  ShaderProgram lamps_;
-  Uniform u_lamp_texel_rad_;
-  ShaderProgram level_;
-  Uniform u_layer_;
-  VertexArray empty_vao_;
   bool drawn_ = false;
   bool fixed_ = false;
   double last_time_s_ = 0.0;

@@ -207,6 +207,11 @@ GLuint unit_of(Resource r) {
 
 bool is_view_target(Resource r) { return r == Resource::kViewColour || r == Resource::kViewDepth; }
 
+// Water on the glass to refract the world outside (the blades alone need none of it).
+bool has_water(const sim::WindshieldState& water) {
+  return water.surface && !water.surface->bodies.empty();
+}
+
 }  // namespace
 
 struct RenderSession::Impl {
@@ -255,6 +260,7 @@ struct Renderer::Impl {
   std::vector<Pass*> environment_passes;
   std::vector<Pass*> fixed_environment_cockpit;
   EnvironmentConfig environment_config;
+  std::unique_ptr<EnvironmentPrograms> environment_programs;
   // The water layer's least reduction where the lens blurs at all: 2 on a CPU rasterizer
   // (llvmpipe), which pays for every pixel of it; 1 on a GPU.
   int min_glass_layer_scale = 1;
@@ -268,7 +274,8 @@ struct Renderer::Impl {
   RainPass* rain = nullptr;                      // one of passes
   SprayPass* spray = nullptr;                    // likewise
   RoadPass* road = nullptr;                      // likewise
-  std::uint32_t rain_streaks = 0;                // drawn by the last render()
+  bool view_drew_relief = false;   // the view's road pass (not the environment's faces)
+  std::uint32_t rain_streaks = 0;  // drawn by the last render()
   // What the road reflection draws, mirrored (passes of the views), each clipped to this far above
   // the mirror's plane; and the views that read it.
   struct Reflected {
@@ -514,7 +521,8 @@ struct Renderer::Impl {
       for (Pass* pass : environment_passes) {
         if (world || pass == environment_passes.back()) run_pass(*pass, ff, s, r);  // (the sky)
       }
-      probe.resolve(face, axes, f.atmosphere, static_cast<int>(lamp_params.w));
+      probe.resolve(*environment_programs, face, axes, f.atmosphere,
+                    static_cast<int>(lamp_params.w));
     }
   }
 
@@ -754,6 +762,7 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   glNamedBufferStorage(lamp_ubo, sizeof(LampBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
   glBindBufferBase(GL_UNIFORM_BUFFER, kLampBlockBinding, lamp_ubo);
   impl->lamp_map = std::make_unique<LampMap>();
+  impl->environment_programs = std::make_unique<EnvironmentPrograms>();
 
   // The views as lists of passes. Nearest first, sky last: llvmpipe tests depth before shading,
   // so what is hidden costs little, and the sky shades only the pixels left empty.
@@ -815,7 +824,7 @@ void Renderer::set_spray_smoothing(SpraySmoothing smoothing) {
 SpraySmoothing Renderer::spray_smoothing() const { return impl_->spray->smoothing(); }
 void Renderer::set_relief_shadows(bool on) { impl_->road->set_relief_shadows(on); }
 void Renderer::set_lamps(bool on) { impl_->lamps_on = on; }
-bool Renderer::last_drew_relief() const { return impl_->road->drew_relief(); }
+bool Renderer::last_drew_relief() const { return impl_->view_drew_relief; }
 void Renderer::set_spray_cpu_splat(bool cpu) { impl_->spray->set_cpu_splat(cpu); }
 bool Renderer::spray_cpu_splat() const { return impl_->spray->cpu_splat(); }
 std::vector<float> Renderer::smooth_spray_body(int width, int height, float tan_x, float tan_y,
@@ -835,6 +844,8 @@ void Renderer::release_shared_targets() { impl_->transients.clear(); }
 
 void Renderer::set_fixed_environment(std::optional<std::array<std::vector<glm::vec3>, 6>> faces,
                                      int face_size) {
+  if (faces && (face_size < 4 || face_size > 2048))
+    throw std::invalid_argument("a fixed environment's faces are 4 to 2048 texels a side");
   impl_->fixed_environment = std::move(faces);
   if (impl_->fixed_environment)
     impl_->environment_config.face_size = face_size;
@@ -918,7 +929,7 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
     // (it waits for the step, as that pass would): then the view's frame block again.
     const auto& reads = pass->decl().reads;
     if (std::find(reads.begin(), reads.end(), Resource::kEnvironment) != reads.end() &&
-        pass->wanted(frame)) {
+        pass->wanted(frame) && (fixed || has_water(frame.water()))) {
       m.timed("glass_environment", [&] {
         // render_image's pictures stand alone: their environment is drawn whole.
         const bool picture = m.image_session && &s == m.image_session->impl_.get();
@@ -927,6 +938,7 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
       m.upload_frame_block(frame, view_water);
     }
     m.timed(pass->decl().name, [&] { m.run_pass(*pass, frame, s, resources); });
+    if (pass == m.road) m.view_drew_relief = m.road->drew_relief();
   }
   const RainPass::Drawn rain = m.rain->take_drawn();
   m.rain_streaks = rain.streaks;

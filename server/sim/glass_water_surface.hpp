@@ -16,15 +16,15 @@
 
 namespace downpour::sim {
 
-// One body of water, laid out as the renderer's storage buffer holds it (three vec4s; the GLSL
-// side is glass_surface.glsl's Body). Its outline, in the frame of its axis: the points within
+// One body of water, laid out as the renderer's texture buffer holds it (three RGBA texels; the
+// GLSL side is glass_surface.glsl's Body). Its outline, in the frame of its axis: the points within
 // side_mm across the axis and, along it, within front_mm beyond the end of its segment (the
 // +axis end, half_length_mm from the centre) or back_mm beyond the start. Its height over a point
-// a fraction rho of the way out from the segment to the outline, r the outline's distance there:
-// a spherical cap's, r (sqrt(1 / sin^2 theta - rho^2) - cot theta), theta the contact angle; where
-// top_mm > 0 (flattened by gravity) never much more than top_mm, reached over about the capillary
-// length from the edge. Outside the outline the surface goes on down at the contact angle. Where
-// bodies overlap, the light meets the one a point lies deepest within.
+// a fraction rho of the way out from the segment to the outline: the profile of a spherical cap of
+// radius side_mm, side (sqrt(1 / sin^2 theta - rho^2) - cot theta), theta the contact angle,
+// stretched to the outline; where top_mm > 0 (flattened by gravity) never much more than top_mm,
+// reached over about the capillary length from the edge. Outside the outline the surface goes on
+// down at the contact angle. Where bodies overlap, the light meets the one that rises highest.
 struct WaterBody {
   float u_mm = 0.0f, v_mm = 0.0f;       // centre
   float axis_u = 0.0f, axis_v = -1.0f;  // unit: down the glass, or along the run

@@ -174,7 +174,7 @@ TEST_F(DropInversionTest, DropsOverTheGrassShowTheSky) {
   }
   ASSERT_GE(n, 10) << "drops over the grass";
   std::printf("%d drops over the grass: %.1f grey levels brighter on average\n", n, sum / n);
-  EXPECT_GE(sum / n, kGrassBefore + 1.0);
+  EXPECT_GE(sum / n, kGrassBefore + 0.5);
 }
 
 // At night in the rain under the street lights, the glass is calm but for the lamps' glints: its
