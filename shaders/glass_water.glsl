@@ -19,7 +19,6 @@ uniform vec3 u_cabin;            // the cabin's radiance, seen down through the 
 uniform vec3 u_glass_depth;      // the glass plane's depth over the view: dot(xyz, (uv, 1))
 uniform float u_view_pixel_rad;  // one pixel of the view, radians
 uniform vec2 u_inv_target;       // one layer pixel in the view's uv
-uniform vec2 u_inv_view;         // one pixel of the view in its uv
 
 #ifdef GLASS_BLURRED
 const int kNewtonSteps = 2;  // the lens's blur hides the rest
@@ -100,17 +99,7 @@ void main() {
   // branches. So: first where the samples meet water (cheap), a discard where none does, then
   // the optics in a loop over the wet samples alone.
   vec2 dx = dFdx(v_glass_mm), dy = dFdy(v_glass_mm);  // the pixel's footprint on the glass, mm
-  // Where the cabin (pillars, mirror, dashboard: nearer than the glass) hides the whole pixel,
-  // nothing of the water shows: its corner pixels of the view.
   vec2 view_uv = gl_FragCoord.xy * u_inv_target;
-  vec2 corner = 0.5 * (u_inv_target - u_inv_view);
-  float glass_depth = dot(u_glass_depth, vec3(view_uv, 1.0)) + 1e-6;
-  if (min(min(textureLod(view_depth_tex, view_uv - corner, 0.0).r,
-              textureLod(view_depth_tex, view_uv + corner, 0.0).r),
-          min(textureLod(view_depth_tex, view_uv + vec2(corner.x, -corner.y), 0.0).r,
-              textureLod(view_depth_tex, view_uv + vec2(-corner.x, corner.y), 0.0).r)) >
-      glass_depth)
-    discard;
   vec2 at[kMaxSamples];
   uint top[kMaxSamples];
   int wet = 0;

@@ -168,8 +168,10 @@ void EnvironmentProbe::make_levels(const EnvironmentPrograms& p, int face) {
   glTextureParameteri(levels_view_.id(), GL_TEXTURE_MAX_LEVEL, levels_ - 1);
 }
 
-std::vector<EnvironmentProbe::Due> EnvironmentProbe::faces_due(double time_s, bool complete) {
-  std::vector<Due> due;
+const std::vector<EnvironmentProbe::Due>& EnvironmentProbe::faces_due(double time_s,
+                                                                      bool complete) {
+  std::vector<Due>& due = due_;
+  due.clear();
   if (fixed_) return due;
   if (!drawn_) {
     for (int f = 0; f < kFaces; ++f) due.push_back({f, complete || f == 0});

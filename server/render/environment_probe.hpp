@@ -59,9 +59,6 @@ class EnvironmentProbe {
 
   const EnvironmentConfig& config() const { return config_; }
   GLuint texture() const { return cube_.id(); }
-  int levels() const { return levels_; }
-  // Texels per radian at the finest level, at a face's centre.
-  float texels_per_radian() const { return 0.5f * static_cast<float>(config_.face_size); }
 
   // The direction in the probe's axes through point xy (each in [-1, 1], x right, y up) of face
   // `face` (GL's cube face order: +x -x +y -y +z -z), unnormalised.
@@ -92,11 +89,11 @@ class EnvironmentProbe {
     int face;
     bool world;
   };
-  std::vector<Due> faces_due(double time_s, bool complete);
+  // (Kept by the probe, so that a tick allocates nothing.)
+  const std::vector<Due>& faces_due(double time_s, bool complete);
   // A fixed environment instead of the world (tests): six faces of linear RGB, face_size^2 texels
   // each, rows from the bottom. The probe then never refreshes.
   void set_fixed(const std::array<std::vector<glm::vec3>, kFaces>& faces);
-  bool fixed() const { return fixed_; }
 
  private:
   void make_levels(const EnvironmentPrograms& programs, int face);
@@ -108,6 +105,7 @@ class EnvironmentProbe {
   Texture levels_view_;
   Texture face_colour_, face_depth_;
   Framebuffer face_fbo_, resolve_fbo_;
+  std::vector<Due> due_;
   bool drawn_ = false;
   bool fixed_ = false;
   double last_time_s_ = 0.0;

@@ -480,7 +480,7 @@ struct Renderer::Impl {
       if (fixed_environment) s.environment->set_fixed(*fixed_environment);
     }
     EnvironmentProbe& probe = *s.environment;
-    const std::vector<EnvironmentProbe::Due> due = probe.faces_due(f.scene.sim_time_s, complete);
+    const std::vector<EnvironmentProbe::Due>& due = probe.faces_due(f.scene.sim_time_s, complete);
     if (due.empty()) return;
     const sim::GlassConfig& glass = f.scene.glass;
     const glm::dvec3 centre_vehicle =

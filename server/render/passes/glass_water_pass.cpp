@@ -12,7 +12,8 @@ glm::vec3 cabin_radiance(const Atmosphere& atmosphere, const GlassWaterConfig& c
   return atmosphere.ambient * config.cabin_per_ambient;
 }
 
-GlassWaterPass::Optics::Optics(const char* fragment_file, const GlassWaterConfig& config)
+GlassWaterPass::Optics::Optics(const char* fragment_file, bool sharp,
+                               const GlassWaterConfig& config)
     : program(std::make_unique<ShaderProgram>("glass.vert", fragment_file)),
       quad(*program),
       cells(program->uniform("u_cells")),
@@ -20,11 +21,13 @@ GlassWaterPass::Optics::Optics(const char* fragment_file, const GlassWaterConfig
       env_max_lod(program->uniform("u_env_max_lod")),
       env_from_world(program->uniform("u_env_from_world")),
       cabin(program->uniform("u_cabin")),
-      glass_depth(program->uniform("u_glass_depth")),
+
       view_pixel_rad(program->uniform("u_view_pixel_rad")),
       inv_target(program->uniform("u_inv_target")),
-      inv_view(program->uniform("u_inv_view")),
       samples(program->uniform("u_samples")) {
+  // The view's own image, and so the glass plane's depth that tells the cabin from it, is the
+  // sharp program's alone.
+  if (sharp) glass_depth = program->uniform("u_glass_depth");
   program->uniform("u_water_ior").set(config.water_ior);
   program->uniform("u_cell_mm").set(static_cast<float>(sim::GlassWaterSurface::kCellMm));
   program->uniform("u_count_bits").set(static_cast<unsigned>(sim::GlassWaterSurface::kCountBits));
@@ -32,8 +35,8 @@ GlassWaterPass::Optics::Optics(const char* fragment_file, const GlassWaterConfig
 
 GlassWaterPass::GlassWaterPass(SharedResources&, GlassWaterConfig config)
     : config_(config),
-      sharp_("glass_water.frag", config_),
-      blurred_("glass_water_blurred.frag", config_) {}
+      sharp_("glass_water.frag", true, config_),
+      blurred_("glass_water_blurred.frag", false, config_) {}
 
 bool GlassWaterPass::wanted(const FrameContext& frame) const {
   // (The blades alone still need the glass layer, which this pass makes: the composite draws them.)
@@ -53,13 +56,12 @@ void GlassWaterPass::execute(const FrameContext& frame, const FrameResources& re
   o.env_max_lod.set(std::max(std::log2(static_cast<float>(face)) - 3.0f, 0.0f));
   o.env_from_world.set(glm::mat4(resources.environment_from_world));
   o.cabin.set(cabin_radiance(frame.atmosphere, config_));
-  o.glass_depth.set(frame.glass.depth_over_image());
+  if (&o == &sharp_) o.glass_depth.set(frame.glass.depth_over_image());
   o.view_pixel_rad.set(2.0f * static_cast<float>(frame.camera.tan_half_fov_y) /
                        static_cast<float>(std::max(frame.spec.height, 1)));
   const int samples = config_.samples_by_scale[scale - 1];
   o.samples.set(samples >= 16 ? 16 : samples >= 4 ? 4 : 2);
   o.inv_target.set(1.0f / glm::vec2(resources.glass_layer.width, resources.glass_layer.height));
-  o.inv_view.set(1.0f / glm::vec2(resources.view_colour.width, resources.view_colour.height));
   o.quad.draw(frame);  // also the glass's axes, for the rays' frame
 }
 

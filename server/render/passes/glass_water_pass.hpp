@@ -50,11 +50,11 @@ class GlassWaterPass final : public Pass {
   // A program of the optics and its uniforms: the sharp one (a pinhole's full-size layer) and the
   // blurred one (glass_water.glsl).
   struct Optics {
-    Optics(const char* fragment_file, const GlassWaterConfig& config);
+    Optics(const char* fragment_file, bool sharp, const GlassWaterConfig& config);
     std::unique_ptr<ShaderProgram> program;  // (where the quad's uniforms point)
     GlassQuad quad;
     Uniform cells, env_per_rad, env_max_lod, env_from_world, cabin, glass_depth, view_pixel_rad;
-    Uniform inv_target, inv_view, samples;
+    Uniform inv_target, samples;
   };
   GlassWaterConfig config_;
   Optics sharp_, blurred_;

@@ -164,7 +164,9 @@ TEST_F(DropReferenceTest, EachDropMatchesTheRayTracedReference) {
         drop.radius_mm, drop.contact_angle_deg, pixels, mae, dry_mae, dir.c_str(), name);
     EXPECT_LE(mae, 8.0) << "r " << drop.radius_mm << " mm, " << drop.contact_angle_deg << " deg";
     // The bound means something: the drop not drawn at all misses the reference by more.
-    if (drop.radius_mm >= 1.0) EXPECT_GE(dry_mae, 2.0 * mae + 8.0) << drop.radius_mm;
+    if (drop.radius_mm >= 1.0) {
+      EXPECT_GE(dry_mae, 2.0 * mae + 8.0) << drop.radius_mm;
+    }
   }
 }
 
