@@ -106,8 +106,8 @@ json measure_stages(const sim::Scenario& scenario, const sim::ViewSpec& spec, in
   encode::JpegEncoder encoder;
   sim::Simulation simulation(scenario.seed, scenario.at(0.0));
   warm(simulation, scenario, warm_s);
-  std::vector<double> step_ms, water_ms, map_ms, rain_field_ms, road_water_ms, render_ms,
-      readback_ms, encode_ms, frame_ms, cpu_ms;
+  std::vector<double> step_ms, water_ms, map_ms, surface_ms, rain_field_ms, road_water_ms,
+      render_ms, readback_ms, encode_ms, frame_ms, cpu_ms;
   std::vector<std::uint8_t> pixels;
   const double dt = 1.0 / scenario.fps;
   constexpr int kWarmup = 3;  // the first frames compile shader variants
@@ -130,6 +130,7 @@ json measure_stages(const sim::Scenario& scenario, const sim::ViewSpec& spec, in
     step_ms.push_back(ms_between(t0, t1));
     water_ms.push_back(simulation.last_advance_timing().water_ms);
     map_ms.push_back(simulation.last_advance_timing().publish_ms);
+    surface_ms.push_back(simulation.last_advance_timing().surface_ms);
     rain_field_ms.push_back(simulation.last_advance_timing().rain_ms);
     road_water_ms.push_back(simulation.last_advance_timing().road_ms);
     render_ms.push_back(ms_between(t1, t2));
@@ -144,6 +145,7 @@ json measure_stages(const sim::Scenario& scenario, const sim::ViewSpec& spec, in
   j["water_step_ms"] = median(water_ms);
   j["water_step_ms_p90"] = percentile(water_ms, 0.9);
   j["water_map_ms"] = median(map_ms);
+  j["water_surface_ms"] = median(surface_ms);  // of it: the glass water's bodies and grid
   j["rain_field_ms"] = median(rain_field_ms);  // the rain in the air's step and copy
   j["road_water_ms"] = median(road_water_ms);  // the water on the road's steps
   j["render_submit_ms"] = median(render_ms);   // issuing the commands (llvmpipe rasterizes some)

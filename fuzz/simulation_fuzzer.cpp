@@ -1,7 +1,7 @@
 // Fuzz target: the simulation under a feed a client could send. The input is a sequence of
 // (length, DriveRequest bytes) records; each request the service would accept is applied and the
-// simulation advanced by its dt_s (capped at 0.2 s per input, and on a coarse water map, so that
-// one input stays quick: the same code at a quarter of the resolution). After every step the state
+// simulation advanced by its dt_s (capped at 0.2 s per input, with a small rain box and road, so
+// that one input stays quick). After every step the state
 // must be finite and the water must be accounted for: what arrived on the glass is on it, wiped
 // off, drained or evaporated; the rain in the air stays bounded and finite; the road's water is
 // finite and its ledger closes.
@@ -80,15 +80,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const rpc::Limits limits;
   const std::uint8_t seed = in.ConsumeIntegral<std::uint8_t>();
   // A fresh simulation for each seed is built once and copied for each input: the copy is the
-  // same state as a new one, at a small part of the cost (the glass mesh and the first map).
+  // same state as a new one, at a small part of the cost (the glass mesh).
   static std::array<std::unique_ptr<sim::Simulation>, 256> fresh;
   if (!fresh[seed]) {
     sim::Update initial;
     initial.weather = sim::Weather{};
     initial.weather->rain_rate_mm_h = 20.0;
     sim::SimulationConfig config;
-    config.water_map.texel_mm = 8.0;
-    // A smaller rain box (the same code, a twentieth of the drops), like the coarse map.
+    // A smaller rain box (the same code, a twentieth of the drops).
     config.rain.length_m = 6.0;
     config.rain.width_m = 4.0;
     config.rain.height_m = 3.0;

@@ -62,7 +62,6 @@ struct FrameResources {
   TargetTexture view_depth;
   GLuint glass_layer_fbo = 0;
   TargetTexture glass_layer;
-  TargetTexture glass_water;  // the session's glass water map
   TargetTexture environment;  // the session's environment probe (a cube map: a face's size)
   glm::mat3 environment_from_world{1.0f};  // turns world directions into the probe's axes
   TargetTexture road_reflection;           // drawn before the passes where the view reads it

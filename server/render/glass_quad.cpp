@@ -21,6 +21,17 @@ void GlassPlacement::set(const FrameContext& frame) const {
   size_mm_.set(glm::vec3(glass.bottom_width_mm, glass.top_width_mm, glass.height_mm));
 }
 
+GlassSurfaceGrid::GlassSurfaceGrid(const ShaderProgram& program)
+    : cells_(program.uniform("u_cells")) {
+  program.uniform("u_cell_mm").set(static_cast<float>(sim::GlassWaterSurface::kCellMm));
+  program.uniform("u_count_bits").set(static_cast<unsigned>(sim::GlassWaterSurface::kCountBits));
+}
+
+void GlassSurfaceGrid::set(const sim::WindshieldState& water) const {
+  const sim::GlassWaterSurface* surface = water.surface.get();
+  cells_.set(surface ? glm::ivec2(surface->cells_u, surface->cells_v) : glm::ivec2(0));
+}
+
 GlassQuad::GlassQuad(const ShaderProgram& program) : placement_(program) {
   GLuint vao = 0;
   glCreateVertexArrays(1, &vao);
@@ -33,16 +44,11 @@ void GlassQuad::draw(const FrameContext& frame) const {
   glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
 }
 
-glm::vec2 map_size_mm(const sim::GlassWaterMap& map, const sim::GlassConfig& glass) {
-  if (map.width <= 0 || map.height <= 0) return glm::vec2(glass.bottom_width_mm, glass.height_mm);
-  return glm::vec2(map.width, map.height) * static_cast<float>(map.texel_mm);
-}
-
 bool glass_has_water_or_blades(const sim::WindshieldState& water) {
   const bool any_blade =
       std::any_of(water.blades.begin(), water.blades.end(),
                   [](const sim::BladePose& b) { return b.length_mm > 0.0f && b.width_mm > 0.0f; });
-  return any_blade || water.map.wet_fraction > 0.0 || !water.metaballs.empty() ||
+  return any_blade || water.glass_wet_fraction > 0.0 || !water.metaballs.empty() ||
          (water.surface && !water.surface->bodies.empty());
 }
 

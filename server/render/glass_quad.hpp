@@ -1,5 +1,6 @@
 // The windshield trapezoid drawn at its place in the world (glass.vert), for the passes that draw
-// on the glass; and whether a frame has anything on its glass at all.
+// on the glass; the grid of the water's surface for those that read it (glass_surface.glsl); and
+// whether a frame has anything on its glass at all.
 #pragma once
 
 #include "server/render/frame_context.hpp"
@@ -17,6 +18,17 @@ class GlassPlacement {
   Uniform origin_, u_, v_, size_mm_;
 };
 
+// The water surface's grid for a program that includes glass_surface.glsl: u_cell_mm and
+// u_count_bits once, u_cells per frame (its bodies are bound by the Resource kGlassSurface).
+class GlassSurfaceGrid {
+ public:
+  explicit GlassSurfaceGrid(const ShaderProgram& program);
+  void set(const sim::WindshieldState& water) const;
+
+ private:
+  Uniform cells_;
+};
+
 class GlassQuad {
  public:
   explicit GlassQuad(const ShaderProgram& program);  // one that uses glass.vert
@@ -27,9 +39,6 @@ class GlassQuad {
   GlassPlacement placement_;
   VertexArray empty_vao_;
 };
-
-// The glass-space size (mm) that the glass water map covers; without a map, the glass's.
-glm::vec2 map_size_mm(const sim::GlassWaterMap& map, const sim::GlassConfig& glass);
 
 // Water or a blade on the glass: without either there is nothing to draw on it.
 bool glass_has_water_or_blades(const sim::WindshieldState& water);

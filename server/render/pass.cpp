@@ -13,8 +13,6 @@ std::string_view resource_name(Resource r) {
       return "view depth";
     case Resource::kGlassLayer:
       return "glass layer";
-    case Resource::kGlassWater:
-      return "glass water map";
     case Resource::kGlassSurface:
       return "glass water surface";
     case Resource::kEnvironment:
@@ -31,9 +29,8 @@ std::string_view resource_name(Resource r) {
 
 void check_pass_order(std::string_view view, const std::vector<Pass*>& passes) {
   // The frame provides these from its start (the simulation's, or drawn before the passes).
-  const std::vector<Resource> provided = {Resource::kGlassWater, Resource::kGlassSurface,
-                                          Resource::kEnvironment, Resource::kRoadWater,
-                                          Resource::kRoadReflection};
+  const std::vector<Resource> provided = {Resource::kGlassSurface, Resource::kEnvironment,
+                                          Resource::kRoadWater, Resource::kRoadReflection};
   std::vector<Resource> available = {Resource::kViewColour, Resource::kViewDepth};
   available.insert(available.end(), provided.begin(), provided.end());
   auto fail = [&](const PassDecl& d, std::string_view what, Resource r) {

@@ -19,8 +19,8 @@ enum class Resource : std::uint8_t {
   kViewColour,  // the view's colour target: cleared at the frame's start
   kViewDepth,   // its depth (reversed-Z): cleared at the frame's start
   kGlassLayer,  // the water on the glass over the scene, reduced size, premultiplied
-  kGlassWater,  // the session's glass water map, uploaded from the simulation on first read
-  // The water's surface on the glass (sim::GlassWaterSurface), uploaded likewise.
+  // The water's surface on the glass (sim::GlassWaterSurface), uploaded from the simulation on
+  // first read.
   kGlassSurface,
   // The world outside the windshield as a cube map (environment_probe.hpp), the session's, which
   // the renderer refreshes before the view's passes where one reads it.
@@ -31,7 +31,7 @@ enum class Resource : std::uint8_t {
   kRoadReflection,
   kSprayLayer,  // the spray over the scene, half the view, premultiplied
 };
-inline constexpr std::size_t kResourceCount = 9;
+inline constexpr std::size_t kResourceCount = 8;
 std::string_view resource_name(Resource resource);
 
 struct PassDecl {

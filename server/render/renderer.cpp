@@ -189,8 +189,6 @@ GLuint unit_of(Resource r) {
       return texture_unit::kViewDepth;
     case Resource::kGlassLayer:
       return texture_unit::kGlassLayer;
-    case Resource::kGlassWater:
-      return texture_unit::kGlassWater;
     case Resource::kGlassSurface:
       return 0;  // three texture buffers (upload_glass_surface)
     case Resource::kEnvironment:
@@ -216,11 +214,6 @@ bool has_water(const sim::WindshieldState& water) {
 
 struct RenderSession::Impl {
   std::vector<std::unique_ptr<ViewTarget>> views;
-  // The glass water map on the GPU and the content it holds.
-  Texture glass_water;
-  int water_width = 0;
-  int water_height = 0;
-  std::uint64_t water_stamp = 0;
   // The water's surface on the GPU (bodies, cells, entries: buffers, read as texture buffers) and
   // what it holds.
   std::array<Buffer, 3> glass_surface;
@@ -396,38 +389,6 @@ struct Renderer::Impl {
       }
       transients.erase(oldest);
     }
-  }
-
-  // The session's glass water map brought up to this frame's: the rows that changed when the
-  // texture holds the previous frame's map, else the whole map.
-  void upload_glass_water(RenderSession::Impl& s, const sim::GlassWaterMap& map) {
-    if (map.width <= 0 || map.height <= 0 ||
-        map.rgba.size() < static_cast<std::size_t>(map.width) * map.height * 4) {
-      // No map (a scene made without a simulation): one texel of dry glass.
-      static const sim::GlassWaterMap dry{1, 1, 1.0, {128, 128, 0, 0}};
-      if (&map != &dry) upload_glass_water(s, dry);
-      return;
-    }
-    if (s.water_stamp == map.stamp && s.water_width == map.width && s.water_height == map.height)
-      return;
-    int first = 0, last = map.height;
-    if (!s.glass_water.id() || s.water_width != map.width || s.water_height != map.height) {
-      s.glass_water = make_texture_2d(GL_RGBA8, map.width, map.height);
-      glTextureParameteri(s.glass_water.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-      glTextureParameteri(s.glass_water.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-      s.water_width = map.width;
-      s.water_height = map.height;
-    } else if (s.water_stamp != 0 && s.water_stamp == map.previous_stamp) {
-      first = std::clamp(map.dirty_row_begin, 0, map.height);
-      last = std::clamp(map.dirty_row_end, first, map.height);
-    }
-    if (last > first) {
-      glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-      glTextureSubImage2D(s.glass_water.id(), 0, 0, first, map.width, last - first, GL_RGBA,
-                          GL_UNSIGNED_BYTE,
-                          map.rgba.data() + static_cast<std::size_t>(first) * map.width * 4);
-    }
-    s.water_stamp = map.stamp;
   }
 
   // The session's water surface on the glass brought up to the frame's (a whole upload for each
@@ -625,11 +586,6 @@ struct Renderer::Impl {
           break;
         case Resource::kGlassLayer:
           texture = r.glass_layer.texture;
-          break;
-        case Resource::kGlassWater:
-          upload_glass_water(session, f.water().map);
-          r.glass_water = {session.glass_water.id(), session.water_width, session.water_height};
-          texture = r.glass_water.texture;
           break;
         case Resource::kGlassSurface:
           upload_glass_surface(session, f.water().surface);

@@ -13,8 +13,6 @@ namespace downpour::render {
 #define DOWNPOUR_TEXTURE_UNITS(X)                                                                  \
   X(kNoise, 1, sampler2D, noise_tex, "value noise, 4 frequencies in rgba, repeating")              \
   X(kAsphalt, 2, sampler2D, asphalt_tex, "asphalt relief: rgb normal, a height (seed 003, 3.1)")   \
-  X(kGlassWater, 3, sampler2D, glass_water_tex,                                                    \
-    "the session's glass water map: normal uv, compressed height, coverage")                       \
   X(kEnvironment, 4, samplerCube, environment_tex,                                                 \
     "the world outside the windshield from its centre, world axes, linear radiance with the sun "  \
     "and lamps at their energy, mipmapped (environment_probe.hpp)")                                \

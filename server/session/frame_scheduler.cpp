@@ -155,8 +155,6 @@ void FrameScheduler::run(std::promise<void>* started) {
     sim::Simulation warm_sim(0, {});
     warm_scene.windshield.metaballs.push_back({700.0f, 400.0f, 3.0f});
     warm_scene.windshield.blades = warm_sim.state().windshield.blades;
-    sim::GlassWaterMapBuilder(warm_scene.glass)
-        .build(warm_scene.windshield.metaballs, warm_scene.windshield.map);
     warm_scene.windshield.surface =
         sim::surface_from_metaballs(warm_scene.windshield.metaballs, warm_scene.glass);
     for (const sim::View view : {sim::View::kCockpit, sim::View::kRoad, sim::View::kWindshield}) {

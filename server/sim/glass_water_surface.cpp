@@ -70,12 +70,15 @@ void GlassWaterSurface::index(const GlassConfig& glass) {
   const float cell = static_cast<float>(kCellMm);
   const float half_diagonal = cell * std::sqrt(0.5f);
   // Every (cell, body) where the body's outline may reach the cell: the cells whose centre lies
-  // within its widest reach of the body's centre line, and half a cell's diagonal more.
-  // (Scratch kept by the thread: the step publishes a surface a tick.)
+  // within its widest reach of the body's centre line, and half a cell's diagonal more; and the
+  // cells whose centre lies within a body's outline, wet. (Scratch kept by the thread: the step
+  // publishes a surface a tick.)
   thread_local std::vector<std::uint64_t> pairs;
   thread_local std::vector<std::uint32_t> fill;
+  thread_local std::vector<std::uint8_t> wet;
   pairs.clear();
   pairs.reserve(bodies.size() * 9);
+  wet.assign(n_cells, 0);
   for (std::size_t k = 0; k < bodies.size(); ++k) {
     const WaterBody b = bodies[k];  // (a copy: the pushes below cannot alias it)
     const float wide = std::max({b.side_mm, b.front_mm, b.back_mm}) + half_diagonal;
@@ -89,10 +92,14 @@ void GlassWaterSurface::index(const GlassConfig& glass) {
       const float dv = (static_cast<float>(j) + 0.5f) * cell - b.v_mm;
       for (int i = i0; i <= i1; ++i) {
         const float du = (static_cast<float>(i) + 0.5f) * cell - b.u_mm;
-        const float along = std::clamp(du * b.axis_u + dv * b.axis_v, -half, half);
-        const float eu = du - along * b.axis_u, ev = dv - along * b.axis_v;
-        if (eu * eu + ev * ev <= wide2)
-          pairs.push_back(static_cast<std::uint64_t>(j * cells_u + i) << 32 | k);
+        // Beyond the centre segment's ends (x) and across it (y): body_rho2's frame.
+        const float along = du * b.axis_u + dv * b.axis_v, y = dv * b.axis_u - du * b.axis_v;
+        const float x = along - std::clamp(along, -half, half);
+        if (x * x + y * y > wide2) continue;
+        const int c = j * cells_u + i;
+        pairs.push_back(static_cast<std::uint64_t>(c) << 32 | k);
+        const float qx = x / (x >= 0.0f ? b.front_mm : b.back_mm), qy = y / b.side_mm;
+        if (qx * qx + qy * qy < 1.0f) wet[static_cast<std::size_t>(c)] = 1;
       }
     }
   }
@@ -111,6 +118,51 @@ void GlassWaterSurface::index(const GlassConfig& glass) {
   entries.resize(pairs.size());
   for (const std::uint64_t pair : pairs)
     entries[fill[pair >> 32]++] = static_cast<std::uint32_t>(pair & 0xffffffffu);
+  // The wet cells' centres over those within the glass's outline ([inset, width - inset] a row).
+  std::size_t glass_cells = 0, wet_cells = 0;
+  for (int j = 0; j < cells_v; ++j) {
+    const double v = (j + 0.5) * kCellMm;
+    if (v > glass.height_mm) break;
+    const double inset = glass.inset_mm(v);
+    const int first_i = std::max(0, static_cast<int>(std::ceil(inset / kCellMm - 0.5)));
+    const int last_i = std::min(
+        static_cast<int>(std::floor((glass.bottom_width_mm - inset) / kCellMm - 0.5)), cells_u - 1);
+    if (last_i < first_i) continue;
+    glass_cells += static_cast<std::size_t>(last_i - first_i + 1);
+    const std::uint8_t* row = wet.data() + static_cast<std::size_t>(j) * cells_u;
+    for (int i = first_i; i <= last_i; ++i) wet_cells += row[i];
+  }
+  wet_fraction =
+      glass_cells ? static_cast<double>(wet_cells) / static_cast<double>(glass_cells) : 0.0;
+}
+
+namespace {
+
+// The square of the fraction of the way out from a body's centre line to its outline through p
+// (glass_surface.glsl's body_rho2).
+float body_rho2(const WaterBody& b, glm::vec2 p) {
+  const float du = p.x - b.u_mm, dv = p.y - b.v_mm;
+  float x = du * b.axis_u + dv * b.axis_v;
+  const float y = dv * b.axis_u - du * b.axis_v;
+  x -= std::clamp(x, -b.half_length_mm, b.half_length_mm);
+  const float qx = x / (x >= 0.0f ? b.front_mm : b.back_mm), qy = y / b.side_mm;
+  return qx * qx + qy * qy;
+}
+
+}  // namespace
+
+float GlassWaterSurface::top_height(glm::vec2 p) const {
+  const int i = static_cast<int>(std::floor(p.x / kCellMm));
+  const int j = static_cast<int>(std::floor(p.y / kCellMm));
+  if (i < 0 || j < 0 || i >= cells_u || j >= cells_v) return 0.0f;
+  const std::uint32_t listing = cells[static_cast<std::size_t>(j) * cells_u + i];
+  const std::uint32_t first = listing >> kCountBits, count = listing & ((1u << kCountBits) - 1u);
+  float highest = 0.0f;
+  for (std::uint32_t e = first; e < first + count; ++e) {
+    const WaterBody& b = bodies[entries[e]];
+    highest = std::max(highest, b.side_mm * (1.0f - body_rho2(b, p)));
+  }
+  return highest;
 }
 
 std::shared_ptr<const GlassWaterSurface> surface_from_metaballs(

@@ -2,8 +2,8 @@
 // water a shape of its own, whose height over the glass the renderer evaluates where a ray crosses
 // it, finer than any map. Small drops are spherical caps; bodies wider than the capillary length
 // flatten under gravity and sag downhill into tears; running drops stretch along their run with a
-// tail; trails are cylinders. Seed 000's height map (glass_water_map.hpp) stays the ground truth
-// of where water is; this is what refracts. Glass space, millimetres; plain data, no GL.
+// tail; trails are cylinders. Where the water is, for every view and for the wet fractions the
+// frames report, is read from here. Glass space, millimetres; plain data, no GL.
 #pragma once
 
 #include <cstdint>
@@ -61,8 +61,16 @@ struct GlassWaterSurface {
   std::vector<std::uint32_t> cells;
   std::vector<std::uint32_t> entries;  // body indices
 
-  // Lists every body in the cells its outline may reach.
+  // The share of the glass's outline under water, from the cells' centres (index()). An unbiased
+  // estimate: a drop smaller than a cell counts whole as often as its area is a cell's.
+  double wet_fraction = 0.0;
+
+  // Lists every body in the cells its outline may reach; counts the wet cells.
   void index(const GlassConfig& glass);
+
+  // The height of a cap as high as the body that rises highest over glass point p, of those its
+  // cell lists (the renderer's water_top): > 0 where p lies under water. Needs index().
+  float top_height(glm::vec2 p) const;
 };
 
 // Round caps at the simulation's contact angle from metaballs of radius r (hand-made windshields

@@ -32,7 +32,6 @@ Simulation::Simulation(std::uint64_t seed, const Update& initial, SimulationConf
       wipers_(config.windshield.wipers),
       water_(config.windshield, seed),
       rain_(seed, config.rain),
-      water_map_(config.windshield.glass, config.water_map),
       blades_at_water_step_(wipers_.poses()),
       surface_(std::make_shared<const RoadSurface>(config.roads ? config.roads : built_in_roads(),
                                                    seed)),
@@ -46,13 +45,14 @@ Simulation::Simulation(std::uint64_t seed, const Update& initial, SimulationConf
 }
 
 void Simulation::publish() {
+  using Clock = std::chrono::steady_clock;
+  const auto t_water = Clock::now();
   water_.publish(state_.windshield);
-  water_map_.build(state_.windshield.metaballs, state_.windshield.map);
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
+  timing_.surface_ms = std::chrono::duration<double, std::milli>(t0 - t_water).count();
   rain_.publish(&state_.rain);
   rain_ms_ +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  state_.windshield.glass_wet_fraction = state_.windshield.map.wet_fraction;
   if (road_image_stale_ || !state_.road_water) {
     auto image = std::make_shared<RoadWaterImage>();
     road_.image(*image);

@@ -8,7 +8,6 @@
 #include <unordered_map>
 #include <vector>
 
-#include "server/sim/glass_water_map.hpp"
 #include "server/sim/lights.hpp"
 #include "server/sim/rain_field.hpp"
 #include "server/sim/road_water.hpp"
@@ -24,7 +23,8 @@ namespace downpour::sim {
 // it).
 struct AdvanceTiming {
   double water_ms = 0.0;    // the windshield water's sub-steps
-  double publish_ms = 0.0;  // the metaballs and the glass water map
+  double publish_ms = 0.0;  // the state the renderer reads: the glass's water, the road's, spray
+  double surface_ms = 0.0;  // of which: the glass water's bodies, their grid and wet fraction
   double rain_ms = 0.0;     // the rain in the air: its steps and its copy for the renderer
   double road_ms = 0.0;     // the water on the road's steps
   double spray_ms = 0.0;    // the spray's steps
@@ -35,7 +35,6 @@ struct SimulationConfig {
   std::shared_ptr<const RoadNetwork> roads;  // null: the built-in track
   EgoGeometry ego;
   WindshieldConfig windshield;
-  GlassWaterMapConfig water_map;
   RainFieldConfig rain;
   RoadWaterConfig road;
   int sub_steps_per_road_step = 8;   // 1/30 s: the road's water changes over seconds
@@ -90,7 +89,6 @@ class Simulation {
   const SceneState& state() const { return state_; }
   const WaterSim& water() const { return water_; }
   const RainField& rain() const { return rain_; }
-  const GlassWaterMapBuilder& water_map() const { return water_map_; }
   const RoadWater& road() const { return road_; }
   const Spray& spray() const { return spray_; }
   const AdvanceTiming& last_advance_timing() const { return timing_; }
@@ -115,7 +113,6 @@ class Simulation {
   WiperMotion wipers_;
   WaterSim water_;
   RainField rain_;
-  GlassWaterMapBuilder water_map_;
   std::array<BladePose, 2> blades_at_water_step_;
   int sub_steps_since_water_ = 0;
   // The road's relief from the seed, shared by copies of the simulation (it never changes; the

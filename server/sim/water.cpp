@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <mutex>
 
 #include <glm/geometric.hpp>
 
@@ -25,7 +27,8 @@ WaterSim::WaterSim(const WindshieldConfig& config, std::uint64_t seed)
       mesh_(config, seed),
       particles_(config.water),
       rain_(config, seed),
-      sweep_(config.water, seed) {
+      sweep_(config.water, seed),
+      surfaces_(std::make_shared<SurfacePool>()) {
   for (int b = 0; b < 2; ++b) {  // parked until the first step says otherwise
     const BladeConfig& c = config_.wipers.blades[b];
     blades_[b] = {glm::vec2(c.pivot_mm), static_cast<float>(c.park_deg * M_PI / 180.0),
@@ -101,12 +104,39 @@ void WaterSim::release_particles(double dt, const WaterInputs& in) {
   particles.resize(kept);
 }
 
+// Surfaces given back by their last reader (a render thread), under a lock.
+struct WaterSim::SurfacePool {
+  std::mutex mutex;
+  std::vector<std::unique_ptr<GlassWaterSurface>> free;
+};
+
+std::shared_ptr<GlassWaterSurface> WaterSim::recycled_surface() const {
+  std::unique_ptr<GlassWaterSurface> surface;
+  {
+    std::lock_guard<std::mutex> lock(surfaces_->mutex);
+    if (!surfaces_->free.empty()) {
+      surface = std::move(surfaces_->free.back());
+      surfaces_->free.pop_back();
+    }
+  }
+  if (!surface) surface = std::make_unique<GlassWaterSurface>();
+  surface->bodies.clear();
+  // The pool outlives the simulation while a reader still holds one of its surfaces.
+  return std::shared_ptr<GlassWaterSurface>(
+      surface.release(), [pool = surfaces_](GlassWaterSurface* given_back) {
+        std::unique_ptr<GlassWaterSurface> owned(given_back);
+        constexpr std::size_t kKept = 4;  // readers hold one for a frame or two
+        std::lock_guard<std::mutex> lock(pool->mutex);
+        if (pool->free.size() < kKept) pool->free.push_back(std::move(owned));
+      });
+}
+
 void WaterSim::publish(WindshieldState& out) const {
   const WaterConfig& w = config_.water;
   const WaterShapeConfig& shape = w.shape;
   out.metaballs.clear();
   out.metaballs.reserve(mesh_.count() * 2 + particles_.particles().size());
-  auto surface = std::make_shared<GlassWaterSurface>();
+  std::shared_ptr<GlassWaterSurface> surface = recycled_surface();
   std::vector<WaterBody>& bodies = surface->bodies;
   bodies.reserve(mesh_.count() * 2 + particles_.particles().size());
   auto add = [&](glm::dvec2 p, double r) {
@@ -182,6 +212,7 @@ void WaterSim::publish(WindshieldState& out) const {
     bodies.push_back(cap(p.pos, drop_radius_mm(p.mass)));
   }
   surface->index(config_.glass);
+  out.glass_wet_fraction = surface->wet_fraction;
   out.surface = std::move(surface);
   out.blades = blades_;
   out.drops = mesh_.count();

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -72,12 +73,17 @@ class WaterSim {
   // The switching of seed 000 (section 1.3): particles outside every moving blade's region
   // become mesh drops, unless suspended next to a large drop (for at most suspension_max_s).
   void release_particles(double dt, const WaterInputs& in);
+  // A surface its last reader has given back, or a new one: publish fills it in place (a tick's
+  // surface is a few hundred kilobytes; reused, the step allocates no more than its handle).
+  std::shared_ptr<GlassWaterSurface> recycled_surface() const;
 
   WindshieldConfig config_;
   MeshModel mesh_;
   ParticleModel particles_;
   RainArrival rain_;
   BladeSweep sweep_;
+  struct SurfacePool;
+  std::shared_ptr<SurfacePool> surfaces_;
   std::array<BladePose, 2> blades_{};  // as of the last step
   double arrived_ = 0.0;
   double released_off_ = 0.0;  // particles left beyond the glass's edge

@@ -93,8 +93,7 @@ struct WaterConfig {
   double sub_metaball_offset = 0.9;   // initial offset, in main radii
   double sub_metaball_radius = 0.55;  // in main radii
   // What the renderer sees of trail drops and impact sub-metaballs changes in this many steps over
-  // their lives (the sim's masses change smoothly): the glass water map is rebuilt only where
-  // something visibly changed.
+  // their lives (the sim's masses change smoothly).
   int published_stages = 6;
   double particle_radius_mm = 1.8;    // particle model: equal particles (3.5 mg each)
   double penalty = 0.25;              // repulsion: extra push as a fraction of the overlap
@@ -132,28 +131,6 @@ struct BladePose {
   float width_mm = 0.0f;
 };
 
-// RGBA8 texels in rows from the glass's bottom edge (v = 0) up; texel (i, j) is centred on glass
-// point ((i + 0.5), (j + 0.5)) * texel_mm, covering the glass's bounding rectangle:
-//   r, g  the water surface normal's glass-parallel part (u, v), * 0.5 + 0.5
-//   b     the compressed height, clamped to [0, 1]
-//   a     water coverage: the threshold, anti-aliased over a texel
-struct GlassWaterMap {
-  int width = 0;
-  int height = 0;
-  double texel_mm = 2.0;
-  std::vector<std::uint8_t> rgba;
-  // Unique to this content in the process: a renderer that holds `previous_stamp` needs only rows
-  // [dirty_row_begin, dirty_row_end) to hold `stamp`.
-  std::uint64_t stamp = 0;
-  std::uint64_t previous_stamp = 0;
-  int dirty_row_begin = 0;
-  int dirty_row_end = 0;
-  double wet_fraction = 0.0;  // of the glass's texels, weighted by coverage
-
-  // Coverage in [0, 1] of the texel under a glass point (mm); 0 off the map.
-  double coverage_at(glm::dvec2 uv_mm) const;
-};
-
 struct GlassWaterSurface;  // glass_water_surface.hpp
 
 struct WindshieldState {
@@ -162,10 +139,9 @@ struct WindshieldState {
   // copies, replaced by each publish. Null: no water to refract.
   std::shared_ptr<const GlassWaterSurface> surface;
   std::array<BladePose, 2> blades;
-  GlassWaterMap map;            // the water as every view samples it (glass_water_map.hpp)
-  std::uint32_t drops = 0;      // mesh drops
-  std::uint32_t particles = 0;  // particle model drops
-  double glass_wet_fraction = 0.0;
+  std::uint32_t drops = 0;          // mesh drops
+  std::uint32_t particles = 0;      // particle model drops
+  double glass_wet_fraction = 0.0;  // of the glass under water (GlassWaterSurface::wet_fraction)
 };
 
 }  // namespace downpour::sim

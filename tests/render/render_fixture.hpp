@@ -72,11 +72,11 @@ class RenderTest : public ::testing::Test {
     }();
     return scene;
   }
-  // The dry scene with this water on its glass (its glass water map built from the metaballs).
+  // The dry scene with this water on its glass (its surface built from the metaballs).
   static RgbaImage render_water(const sim::WindshieldState& water, const sim::ViewSpec& spec) {
     sim::SceneState scene = dry_scene();
     scene.windshield = water;
-    build_water_map(scene.windshield, scene.glass);
+    build_surface(scene.windshield, scene.glass);
     return render(spec, scene);
   }
 

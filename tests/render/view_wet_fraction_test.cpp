@@ -1,30 +1,34 @@
-// The fraction of a COCKPIT view hidden by water, from the glass water map's coverage: none without
-// water, all of it through a glass wholly wet, about half through a glass wet on one side.
+// The fraction of a COCKPIT view hidden by water, from the water's surface on the glass: none
+// without water, all of it through a glass wholly wet, about half through a glass wet on one side
+// or half covered by drops.
 #include "server/render/view_wet_fraction.hpp"
+
+#include <cmath>
+#include <memory>
 
 #include <gtest/gtest.h>
 
 #include "server/render/camera.hpp"
+#include "server/sim/drop_physics.hpp"
+#include "server/sim/glass_water_surface.hpp"
 
 namespace downpour::render {
 namespace {
 
-// A glass water map over the default glass, each texel's coverage from a function of u (mm).
+// Water over the default glass: a cap every `pitch` mm wherever `radius_at_u` (mm, of u) is above 0
+// (3 mm at 4: the caps overlap, the glass is wholly wet).
 template <typename Fn>
-sim::SceneState scene_with_coverage(Fn&& wet_fraction_at_u) {
+sim::SceneState scene_with_caps(Fn&& radius_at_u, float pitch = 4.0f) {
   sim::SceneState scene;
-  sim::GlassWaterMap& map = scene.windshield.map;
-  map.texel_mm = 2.0;
-  map.width = static_cast<int>(scene.glass.bottom_width_mm / map.texel_mm);
-  map.height = static_cast<int>(scene.glass.height_mm / map.texel_mm) + 1;
-  map.rgba.assign(static_cast<std::size_t>(map.width) * map.height * 4, 0);
-  for (int y = 0; y < map.height; ++y) {
-    for (int x = 0; x < map.width; ++x) {
-      const double u = (x + 0.5) * map.texel_mm;
-      map.rgba[(static_cast<std::size_t>(y) * map.width + x) * 4 + 3] =
-          static_cast<std::uint8_t>(255.0 * wet_fraction_at_u(u) + 0.5);
+  auto surface = std::make_shared<sim::GlassWaterSurface>();
+  for (float v = 0.5f * pitch; v < scene.glass.height_mm; v += pitch) {
+    for (float u = 0.5f * pitch; u < scene.glass.bottom_width_mm; u += pitch) {
+      const float r = static_cast<float>(radius_at_u(u));
+      if (r > 0.0f) surface->bodies.push_back(sim::cap_body({u, v}, r, sim::kContactAngleDeg));
     }
   }
+  surface->index(scene.glass);
+  scene.windshield.surface = std::move(surface);
   return scene;
 }
 
@@ -36,12 +40,12 @@ sim::ViewSpec dash_view(double fov_deg = 40.0) {
 sim::ViewSpec driver_view() { return sim::view_spec(sim::View::kCockpit, 640, 360); }
 
 TEST(ViewWetFraction, NoWaterHidesNothing) {
-  EXPECT_EQ(view_wet_fraction(driver_view(), scene_with_coverage([](double) { return 0.0; })), 0.0);
-  EXPECT_EQ(view_wet_fraction(driver_view(), sim::SceneState{}), 0.0);  // no map yet
+  EXPECT_EQ(view_wet_fraction(driver_view(), scene_with_caps([](double) { return 0.0; })), 0.0);
+  EXPECT_EQ(view_wet_fraction(driver_view(), sim::SceneState{}), 0.0);  // no surface yet
 }
 
 TEST(ViewWetFraction, AWetGlassHidesWhatIsSeenThroughIt) {
-  const sim::SceneState wet = scene_with_coverage([](double) { return 1.0; });
+  const sim::SceneState wet = scene_with_caps([](double) { return 3.0; });
   // The dash camera sees only glass.
   EXPECT_GT(view_wet_fraction(dash_view(), wet), 0.99);
   // The driver sees the dashboard, the roof and a side window too: the glass is about half the
@@ -53,15 +57,19 @@ TEST(ViewWetFraction, AWetGlassHidesWhatIsSeenThroughIt) {
 
 TEST(ViewWetFraction, HalfAGlassHidesAboutHalf) {
   // The glass wet on the driver's left half (u < 760); the dash camera on the centre line.
-  const sim::SceneState half = scene_with_coverage([](double u) { return u < 760.0 ? 1.0 : 0.0; });
+  const sim::SceneState half = scene_with_caps([](double u) { return u < 760.0 ? 3.0 : 0.0; });
   EXPECT_NEAR(view_wet_fraction(dash_view(), half), 0.5, 0.1);
-  // Cells half wet everywhere: half of each ray.
-  const sim::SceneState misty = scene_with_coverage([](double) { return 0.5; });
-  EXPECT_NEAR(view_wet_fraction(dash_view(), misty), 0.5, 0.01);
+  // Drops over half the glass everywhere: half the rays. (A pitch that no sampling grid shares.)
+  const float pitch = 4.37f;
+  const double half_covering = pitch * std::sqrt(0.5 / M_PI);
+  const sim::SceneState misty = scene_with_caps([&](double) { return half_covering; }, pitch);
+  EXPECT_NEAR(view_wet_fraction(dash_view(), misty), 0.5, 0.05);
+  // And of the glass itself.
+  EXPECT_NEAR(misty.windshield.surface->wet_fraction, 0.5, 0.02);
 }
 
 TEST(ViewWetFraction, OnlyTheCockpitLooksThroughTheGlass) {
-  const sim::SceneState wet = scene_with_coverage([](double) { return 1.0; });
+  const sim::SceneState wet = scene_with_caps([](double) { return 3.0; });
   for (sim::View view : {sim::View::kRoad, sim::View::kWindshield, sim::View::kRain}) {
     EXPECT_EQ(view_wet_fraction(sim::view_spec(view, 640, 360), wet), 0.0);
   }

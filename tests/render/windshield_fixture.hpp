@@ -1,6 +1,6 @@
 // Hand-made windshield water for the render tests and the render-views tool: deterministic states
 // built without the simulation (drops, trails, wiped sectors, water piled at the blades), and the
-// glass water map that the simulation would publish with them.
+// water's surface that the simulation would publish with them.
 #pragma once
 
 #include <algorithm>
@@ -84,12 +84,10 @@ inline std::array<sim::BladePose, 2> parked_blades() {
   return {blade_at(0, w.blades[0].park_deg), blade_at(1, w.blades[1].park_deg)};
 }
 
-// The glass water map of the metaballs, as the simulation publishes it (its own builder), and
-// their surface: a round cap each.
-inline void build_water_map(sim::WindshieldState& state, const sim::GlassConfig& glass) {
-  sim::GlassWaterMapBuilder(glass).build(state.metaballs, state.map);
+// The surface of the metaballs' water (a round cap each) and the share of the glass it wets.
+inline void build_surface(sim::WindshieldState& state, const sim::GlassConfig& glass) {
   state.surface = sim::surface_from_metaballs(state.metaballs, glass);
-  state.glass_wet_fraction = state.map.wet_fraction;
+  state.glass_wet_fraction = state.surface->wet_fraction;
 }
 
 // Rain on the glass with the wipers part-way up their sweep: drops of many sizes (a main metaball,
@@ -171,7 +169,7 @@ inline sim::WindshieldState rainy_windshield(const sim::GlassConfig& glass, int 
   s.metaballs.resize(std::min<std::size_t>(s.metaballs.size(), metaballs));
   s.particles = static_cast<std::uint32_t>(std::min(particles, s.metaballs.size()));
   s.drops = static_cast<std::uint32_t>(s.metaballs.size()) - s.particles;
-  build_water_map(s, glass);
+  build_surface(s, glass);
   return s;
 }
 
@@ -197,7 +195,7 @@ inline sim::WindshieldState golden_windshield(const sim::GlassConfig& glass) {
   for (int k = 0; k < 6; ++k) {
     s.metaballs.push_back({static_cast<float>(200.0 + 130.0 * k), 300.0f, 1.0f + 1.2f * k});
   }
-  build_water_map(s, glass);
+  build_surface(s, glass);
   return s;
 }
 

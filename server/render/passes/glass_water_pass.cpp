@@ -16,7 +16,7 @@ GlassWaterPass::Optics::Optics(const char* fragment_file, bool sharp,
                                const GlassWaterConfig& config)
     : program(std::make_unique<ShaderProgram>("glass.vert", fragment_file)),
       quad(*program),
-      cells(program->uniform("u_cells")),
+      grid(*program),
       env_per_rad(program->uniform("u_env_per_rad")),
       env_max_lod(program->uniform("u_env_max_lod")),
       env_from_world(program->uniform("u_env_from_world")),
@@ -29,8 +29,6 @@ GlassWaterPass::Optics::Optics(const char* fragment_file, bool sharp,
   // sharp program's alone.
   if (sharp) glass_depth = program->uniform("u_glass_depth");
   program->uniform("u_water_ior").set(config.water_ior);
-  program->uniform("u_cell_mm").set(static_cast<float>(sim::GlassWaterSurface::kCellMm));
-  program->uniform("u_count_bits").set(static_cast<unsigned>(sim::GlassWaterSurface::kCountBits));
 }
 
 GlassWaterPass::GlassWaterPass(SharedResources&, GlassWaterConfig config)
@@ -44,11 +42,10 @@ bool GlassWaterPass::wanted(const FrameContext& frame) const {
 }
 
 void GlassWaterPass::execute(const FrameContext& frame, const FrameResources& resources) {
-  const sim::GlassWaterSurface* surface = frame.water().surface.get();
   const int scale = std::clamp(frame.glass.layer_scale(), 1, 4);
   const Optics& o = scale > 1 ? blurred_ : sharp_;
   o.program->use();
-  o.cells.set(surface ? glm::ivec2(surface->cells_u, surface->cells_v) : glm::ivec2(0));
+  o.grid.set(frame.water());
   const int face = std::max(resources.environment.width, 1);
   o.env_per_rad.set(0.5f * static_cast<float>(face));
   // No coarser than 8 x 8 texels a face (11 degrees each): a ray's light comes from around its own

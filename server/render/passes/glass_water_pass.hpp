@@ -53,7 +53,8 @@ class GlassWaterPass final : public Pass {
     Optics(const char* fragment_file, bool sharp, const GlassWaterConfig& config);
     std::unique_ptr<ShaderProgram> program;  // (where the quad's uniforms point)
     GlassQuad quad;
-    Uniform cells, env_per_rad, env_max_lod, env_from_world, cabin, glass_depth, view_pixel_rad;
+    GlassSurfaceGrid grid;
+    Uniform env_per_rad, env_max_lod, env_from_world, cabin, glass_depth, view_pixel_rad;
     Uniform inv_target, samples;
   };
   GlassWaterConfig config_;

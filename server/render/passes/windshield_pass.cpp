@@ -8,11 +8,9 @@ WindshieldPass::WindshieldPass(SharedResources& shared)
     : shared_(shared),
       program_("fullscreen.vert", "windshield.frag"),
       blades_(program_),
+      grid_(program_),
       u_aspect_(program_.uniform("u_aspect")),
-      u_glass_mm_(program_.uniform("u_glass_mm")),
-      u_map_size_mm_(program_.uniform("u_map_size_mm")) {
-  program_.uniform("u_threshold").set(sim::HeightCompressionConfig{}.threshold);
-}
+      u_glass_mm_(program_.uniform("u_glass_mm")) {}
 
 void WindshieldPass::execute(const FrameContext& frame, const FrameResources&) {
   const sim::GlassConfig& glass = frame.scene.glass;
@@ -20,7 +18,7 @@ void WindshieldPass::execute(const FrameContext& frame, const FrameResources&) {
   program_.use();
   u_aspect_.set(static_cast<float>(frame.spec.width) / static_cast<float>(frame.spec.height));
   u_glass_mm_.set(glm::vec3(glass.bottom_width_mm, glass.top_width_mm, glass.height_mm));
-  u_map_size_mm_.set(map_size_mm(water.map, glass));
+  grid_.set(water);
   blades_.set(water.blades);
   shared_.fullscreen.draw();
 }

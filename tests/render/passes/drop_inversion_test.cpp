@@ -116,7 +116,7 @@ class DropInversionTest : public testing::RenderTest {
   static sim::SceneState without_water(sim::SceneState scene) {
     scene.windshield.surface.reset();
     scene.windshield.metaballs.clear();
-    scene.windshield.map = sim::GlassWaterMap{};
+    scene.windshield.glass_wet_fraction = 0.0;
     return scene;
   }
 };

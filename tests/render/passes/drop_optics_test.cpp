@@ -189,7 +189,7 @@ TEST_F(DropOpticsTest, ALowSunGlintsThroughTheDropsAroundIt) {
   auto glints = [&](const sim::SceneState& scene) {
     sim::SceneState wet = scene;
     wet.windshield = testing::rainy_windshield(scene.glass, 3000);
-    testing::build_water_map(wet.windshield, wet.glass);
+    testing::build_surface(wet.windshield, wet.glass);
     const RgbaImage a = render(spec, wet), b = render(spec, scene);
     // Where the sun shows (or would, ahead): its direction through the camera.
     const Camera camera = make_camera(spec, scene.vehicle);

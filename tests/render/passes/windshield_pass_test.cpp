@@ -32,6 +32,14 @@ class WindshieldPassTest : public testing::RenderTest {
     return {static_cast<int>(kWidth / 2 + (uv_mm.x - 0.5 * g.bottom_width_mm) / mm_per_pixel),
             static_cast<int>(kHeight / 2 - (uv_mm.y - 0.5 * g.height_mm) / mm_per_pixel)};
   }
+  // The glass point at the centre of a view pixel (pixel()'s inverse).
+  static glm::dvec2 centre_of(glm::ivec2 p) {
+    const sim::GlassConfig& g = dry_scene().glass;
+    const double aspect = double(kWidth) / kHeight;
+    const double mm_per_pixel = std::max(g.bottom_width_mm / aspect, g.height_mm) * 1.1 / kHeight;
+    return {0.5 * g.bottom_width_mm + (p.x + 0.5 - kWidth / 2) * mm_per_pixel,
+            0.5 * g.height_mm - (p.y + 0.5 - kHeight / 2) * mm_per_pixel};
+  }
   static const std::uint8_t* at(const RgbaImage& image, glm::ivec2 p) {
     return &image.pixels[(static_cast<std::size_t>(p.y) * image.width + p.x) * 4];
   }
@@ -68,15 +76,17 @@ TEST_F(WindshieldPassTest, ShowsWaterWhereTheMetaballsAreAndBlackElsewhere) {
 }
 
 TEST_F(WindshieldPassTest, ThickerWaterIsBrighter) {
+  // A 3 mm drop rises about 1 mm; a 20 mm body to its flat top, 1.85 mm. Each centred on a pixel.
+  const glm::ivec2 small_at = pixel({400.0, 381.0}), wide_at = pixel({1100.0, 381.0});
+  const glm::dvec2 small = centre_of(small_at), wide = centre_of(wide_at);
   sim::WindshieldState water;
-  water.metaballs.push_back({400.0f, 381.0f, 20.0f});
-  // Three metaballs piled on one spot: higher before compression, still higher after.
-  for (int k = 0; k < 3; ++k) water.metaballs.push_back({1100.0f, 381.0f, 20.0f});
+  water.metaballs.push_back({static_cast<float>(small.x), static_cast<float>(small.y), 3.0f});
+  water.metaballs.push_back({static_cast<float>(wide.x), static_cast<float>(wide.y), 20.0f});
   const RgbaImage image = render(water);
-  const int single = at(image, pixel({400.0, 381.0}))[0];
-  const int pile = at(image, pixel({1100.0, 381.0}))[0];
-  EXPECT_GT(single, 60);
-  EXPECT_GT(pile, single + 30);
+  const int small_grey = at(image, small_at)[0];
+  const int wide_grey = at(image, wide_at)[0];
+  EXPECT_GT(small_grey, 60);
+  EXPECT_GT(wide_grey, small_grey + 30);
 }
 
 TEST_F(WindshieldPassTest, BladesAreBlue) {

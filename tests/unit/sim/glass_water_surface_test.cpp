@@ -108,6 +108,25 @@ TEST(GlassWaterSurfaceTest, EveryPointOfABodyIsListedInItsCell) {
   EXPECT_EQ(one.entries.size(), 9u);
 }
 
+TEST(GlassWaterSurfaceTest, WhereTheWaterIsAndHowMuchOfTheGlassItWets) {
+  const GlassConfig glass;
+  GlassWaterSurface surface;
+  surface.bodies.push_back(cap_body({400.0f, 300.0f}, 2.0f, 40.0));
+  surface.bodies.push_back(cap_body({400.0f, 301.0f}, 1.0f, 40.0));  // lower, inside the first
+  surface.bodies.push_back(cap_body({800.0f, 400.0f}, 10.0f, 40.0));
+  surface.bodies.push_back(cap_body({200.0f, 500.0f}, 20.0f, 40.0));
+  surface.index(glass);
+  // The highest body's cap over a point: r (1 - rho^2); none off the water.
+  EXPECT_FLOAT_EQ(surface.top_height({400.0f, 300.0f}), 2.0f);
+  EXPECT_FLOAT_EQ(surface.top_height({401.0f, 300.0f}), 1.5f);
+  EXPECT_EQ(surface.top_height({404.0f, 300.0f}), 0.0f);
+  EXPECT_EQ(surface.top_height({-5.0f, 300.0f}), 0.0f);
+  // Their area over the trapezoid's, sampled every 4 mm.
+  const double area = M_PI * (4.0 + 100.0 + 400.0);
+  const double glass_area = 0.5 * (glass.bottom_width_mm + glass.top_width_mm) * glass.height_mm;
+  EXPECT_NEAR(surface.wet_fraction, area / glass_area, 0.1 * area / glass_area);
+}
+
 TEST(GlassWaterSurfaceTest, TheSimulationPublishesDropsTearsRunsAndTrails) {
   WindshieldConfig config;
   WaterSim water(config, 11);
