@@ -115,9 +115,9 @@ sanitize() {
   ASAN_OPTIONS="$common" ctest --test-dir "$dir" --output-on-failure --no-tests=error -L unit \
     -j "$(nproc)"
   # A small quarantine: the stalled-reader test bounds the server's resident memory over 3 s, and
-  # ASan's default 256 MB of freed-but-held blocks goes on growing through it (17 MB once, against
-  # a 16 MB bound); 16 MB fills before the test measures. (Not the package test: it builds a program
-  # against the installed libraries, which an ASan build's are not for.)
+  # ASan's default 256 MB of freed-but-held blocks goes on growing through it; 16 MB fills before
+  # the test measures. (Not the package test: it builds a program against the installed
+  # libraries, which an ASan build's are not for.)
   ASAN_OPTIONS="$common:detect_leaks=0:quarantine_size_mb=16" DOWNPOUR_TEST_TIME_SCALE=3 \
     ctest --test-dir "$dir" --output-on-failure \
     --no-tests=error -L 'render|integration' -LE package --timeout 900
