@@ -24,6 +24,7 @@
 #include "server/render/passes/cockpit_pass.hpp"
 #include "server/render/passes/environment_background_pass.hpp"
 #include "server/render/passes/glass_composite_pass.hpp"
+#include "server/render/passes/glass_water_mask_pass.hpp"
 #include "server/render/passes/glass_water_pass.hpp"
 #include "server/render/passes/lamp_glow_pass.hpp"
 #include "server/render/passes/rain_pass.hpp"
@@ -361,7 +362,7 @@ struct Renderer::Impl {
     t.last_frame = frame;
     t.width = width;
     t.height = height;
-    if (r == Resource::kRoadReflection) {
+    if (r == Resource::kRoadReflection || r == Resource::kGlassLayer) {
       t.texture = make_texture_2d(GL_RGBA8, width, height);
       t.depth = make_texture_2d(GL_DEPTH_COMPONENT32F, width, height);
       for (GLuint id : {t.texture.id(), t.depth.id()}) {
@@ -629,11 +630,20 @@ struct Renderer::Impl {
       fbo = t.fbo.id();
       glBindFramebuffer(GL_FRAMEBUFFER, t.fbo.id());
       glViewport(0, 0, t.width, t.height);
-      const float clear[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-      glClearNamedFramebufferfv(t.fbo.id(), GL_COLOR, 0, clear);
+      if (!written[index(out)]) {  // cleared by its first pass of the frame
+        const float clear[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+        glClearNamedFramebufferfv(t.fbo.id(), GL_COLOR, 0, clear);
+        if (t.depth.id()) {  // (the glass layer's: the nearest, for its mask)
+          const float nearest = 1.0f;
+          glDepthMask(GL_TRUE);
+          glClearNamedFramebufferfv(t.fbo.id(), GL_DEPTH, 0, &nearest);
+        }
+      }
     }
     apply(d.state);
     pass.execute(f, r);
+    // Clears outside the passes heed the colour mask: it is left on.
+    if (!d.state.colour_write) glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     for (Resource res : d.writes) written[index(res)] = true;
   }
 
@@ -734,6 +744,7 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   impl->rain = rain;
   Pass* rain_mask = impl->add<RainMaskPass>();
   Pass* environment_background = impl->add<EnvironmentBackgroundPass>();
+  Pass* glass_water_mask = impl->add<GlassWaterMaskPass>();
   Pass* glass_water = impl->add<GlassWaterPass>();
   Pass* glass_composite = impl->add<GlassCompositePass>();
   Pass* windshield = impl->add<WindshieldPass>();
@@ -745,10 +756,11 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   impl->reflected = {{vehicles, -0.02f}, {street_lights, 0.0f}, {terrain, 0.5f}, {sky, 0.0f}};
   auto& views = impl->views;
   views[static_cast<int>(sim::View::kCockpit)] = {
-      cockpit, vehicles, street_lights,   road,        terrain,        sky, glow,
-      rain,    spray,    spray_composite, glass_water, glass_composite};
+      cockpit, vehicles,        street_lights,    road,        terrain,        sky, glow, rain,
+      spray,   spray_composite, glass_water_mask, glass_water, glass_composite};
   impl->environment_passes = {vehicles, street_lights, road, terrain, sky};  // the sky last
-  impl->fixed_environment_cockpit = {environment_background, glass_water, glass_composite};
+  impl->fixed_environment_cockpit = {environment_background, glass_water_mask, glass_water,
+                                     glass_composite};
   check_pass_order("COCKPIT (fixed environment)", impl->fixed_environment_cockpit);
   views[static_cast<int>(sim::View::kRoad)] = {vehicles, street_lights, road,  terrain,        sky,
                                                glow,     rain,          spray, spray_composite};

@@ -45,7 +45,8 @@ class GlassWaterPass final : public Pass {
                        {Resource::kGlassSurface, Resource::kEnvironment, Resource::kViewColour,
                         Resource::kViewDepth},
                        {Resource::kGlassLayer},
-                       {},
+                       // Only where GlassWaterMaskPass found that water may be.
+                       {DepthTest::kNearer, false, Blend::kOff},
                        true};
   // A program of the optics and its uniforms: the sharp one (a pinhole's full-size layer) and the
   // blurred one (glass_water.glsl).
