@@ -118,10 +118,11 @@ struct WindshieldConfig {
 };
 
 // What the renderer reads each frame.
+// A round drop: seed 000's metaball, now a cap of this contact radius (surface_from_metaballs).
 struct Metaball {
   float u_mm = 0.0f;
   float v_mm = 0.0f;
-  float radius_mm = 0.0f;  // the density's R: N = 1 / (1 + (h / R)^4)
+  float radius_mm = 0.0f;
 };
 
 struct BladePose {
