@@ -87,14 +87,20 @@ WaterSurface body_surface(Body b, vec2 p) {
   return WaterSurface(h, dh * o.drho, abs(d2h) / (r * r * g * sqrt(g)));
 }
 
+// The listing of the grid cell under glass point p: first entry << u_count_bits | count (0 off the
+// grid).
+uint cell_listing(vec2 p) {
+  ivec2 cell = ivec2(floor(p / u_cell_mm));
+  if (any(lessThan(cell, ivec2(0))) || any(greaterThanEqual(cell, u_cells))) return 0u;
+  return texelFetch(glass_cells_tex, cell.y * u_cells.x + cell.x).r;
+}
+
 // Whether glass point p lies under water, and the body that rises highest there, whose surface
 // the light meets: of the bodies listed in p's cell, those whose outline holds p, by their cap's
 // height there, about r (1 - rho^2) (a sub-metaball near a drop's centre stays under it).
 bool water_top(vec2 p, out uint top) {
   top = 0u;
-  ivec2 cell = ivec2(floor(p / u_cell_mm));
-  if (any(lessThan(cell, ivec2(0))) || any(greaterThanEqual(cell, u_cells))) return false;
-  uint listing = texelFetch(glass_cells_tex, cell.y * u_cells.x + cell.x).r;
+  uint listing = cell_listing(p);
   uint first = listing >> u_count_bits, count = listing & ((1u << u_count_bits) - 1u);
   float highest = 0.0;
   for (uint i = 0u; i < count; ++i) {

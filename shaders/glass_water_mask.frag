@@ -7,12 +7,7 @@
 #include "glass_surface.glsl"
 in vec2 v_glass_mm;
 in vec3 v_world;
-bool listed(vec2 p) {
-  ivec2 cell = ivec2(floor(p / u_cell_mm));
-  if (any(lessThan(cell, ivec2(0))) || any(greaterThanEqual(cell, u_cells))) return false;
-  uint listing = texelFetch(glass_cells_tex, cell.y * u_cells.x + cell.x).r;
-  return (listing & ((1u << u_count_bits) - 1u)) != 0u;
-}
+bool listed(vec2 p) { return (cell_listing(p) & ((1u << u_count_bits) - 1u)) != 0u; }
 void main() {
   // The footprint's corners and centre: every cell under a footprint up to two cells wide.
   vec2 dx = 0.5 * dFdx(v_glass_mm), dy = 0.5 * dFdy(v_glass_mm);
