@@ -12,7 +12,7 @@ struct WaterSurface {
   float bending;  // the curvature of its profile, 1 / mm (1 / R on a cap)
 };
 
-// One body as the storage buffer holds it.
+// One body as its texture buffer holds it (three texels).
 struct Body {
   vec4 place;  // centre (u, v), axis (unit)
   vec4 reach;  // across, ahead, behind, half its length

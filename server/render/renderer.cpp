@@ -393,7 +393,7 @@ struct Renderer::Impl {
   }
 
   // The session's water surface on the glass brought up to the frame's (a whole upload for each
-  // new one: the step publishes one per tick), bound to its storage buffers.
+  // new one: the step publishes one per tick), bound to its texture buffers.
   void upload_glass_surface(RenderSession::Impl& s,
                             std::shared_ptr<const sim::GlassWaterSurface> surface) {
     // No water (the blades alone): an empty grid, which the optics find dry everywhere.
