@@ -1,8 +1,9 @@
 // The water on the windshield as the view sees it (glass_water_pass.hpp), shared by its programs:
-// glass_water.frag (sharp: the view's own image for rays that barely turn, three Newton steps) and
-// glass_water_blurred.frag (GLASS_BLURRED: the environment alone, two steps). llvmpipe pays for
-// every instruction of a shader on every pixel, whatever its branches take, so what a blurred
-// view can do without is left out of its program, not skipped at run time.
+// glass_water.frag (sharp: the view's own image for rays that barely turn, three Newton steps),
+// glass_water_blurred.frag (GLASS_BLURRED: the environment alone, two steps) and
+// glass_water_pair.frag (blurred, and GLASS_PAIR: two samples a pixel, known when compiled).
+// llvmpipe pays for every instruction of a shader on every pixel, whatever its branches take, so
+// what a program can do without is left out of it, not skipped at run time.
 #include "common.glsl"
 #include "glass_surface.glsl"
 in vec2 v_glass_mm;
@@ -85,6 +86,50 @@ vec3 through_water(vec2 p, uint top, vec3 w, float spacing, mat3 dir_of) {
   return mix(outside(normalize(dir_of * leaving), spread), inside, fresnel);
 }
 
+// The ray in the water: the eye's through this pixel, turned into the glass's frame (u, v, out of
+// the car) and refracted into the water; dir_of turns that frame's directions into the world's.
+struct WaterRay {
+  vec3 w;
+  mat3 dir_of;
+};
+WaterRay water_ray() {
+  vec3 view = normalize(v_world - frame.camera_pos.xyz);
+  vec3 normal = normalize(cross(u_glass_v, u_glass_u));  // out of the car
+  vec3 eye = vec3(dot(view, u_glass_u), dot(view, u_glass_v), dot(view, normal));
+  return WaterRay(refract(eye, vec3(0.0, 0.0, -1.0), 1.0 / u_water_ior),
+                  mat3(u_glass_u, u_glass_v, normal));
+}
+
+// The layer's pixel from the light of its `wet` samples of n that met water (their sum):
+// premultiplied over the view, which the composite adds as it is displayed. What the pixel shows
+// is the display of the light's mean, water and the glass beside it mixed as light.
+vec4 layer_pixel(vec3 sum, int wet, float n) {
+  vec3 behind = textureLod(view_colour_tex, gl_FragCoord.xy * u_inv_target, 0.0).rgb;
+  vec3 shown = to_display((sum + (n - float(wet)) * from_display(behind)) / n);
+  float coverage = float(wet) / n;
+  return vec4(max(shown - (1.0 - coverage) * behind, 0.0), coverage);
+}
+
+// llvmpipe runs both sides of a branch on every pixel; loops and a discard are its real branches.
+// So: first where the samples meet water (cheap), a discard where none does, then the optics in a
+// loop over the wet samples alone.
+#ifdef GLASS_PAIR
+// A diagonal pair of samples: the pair in variables, not arrays (which llvmpipe keeps in memory,
+// a lane at a time, where an index is not known when compiled).
+void main() {
+  vec2 dx = dFdx(v_glass_mm), dy = dFdy(v_glass_mm);  // the pixel's footprint on the glass, mm
+  vec2 p0 = v_glass_mm - 0.25 * (dx + dy), p1 = v_glass_mm + 0.25 * (dx + dy);
+  uint b0, b1;
+  bool w0 = water_top(p0, b0), w1 = water_top(p1, b1);
+  if (!(w0 || w1)) discard;
+  WaterRay ray = water_ray();
+  float spacing = max(length(dx), length(dy)) * inversesqrt(2.0);
+  int wet = int(w0) + int(w1);
+  vec3 sum = through_water(w0 ? p0 : p1, w0 ? b0 : b1, ray.w, spacing, ray.dir_of);
+  for (int k = 1; k < wet; ++k) sum += through_water(p1, b1, ray.w, spacing, ray.dir_of);
+  out_colour = layer_pixel(sum, wet, 2.0);
+}
+#else
 const int kMaxSamples = 16;
 
 // Sample k's place in the pixel, from its centre, in pixels.
@@ -95,11 +140,7 @@ vec2 sample_offset(int k) {
 }
 
 void main() {
-  // llvmpipe runs both sides of a branch on every pixel; loops and a discard are its real
-  // branches. So: first where the samples meet water (cheap), a discard where none does, then
-  // the optics in a loop over the wet samples alone.
   vec2 dx = dFdx(v_glass_mm), dy = dFdy(v_glass_mm);  // the pixel's footprint on the glass, mm
-  vec2 view_uv = gl_FragCoord.xy * u_inv_target;
   vec2 at[kMaxSamples];
   uint top[kMaxSamples];
   int wet = 0;
@@ -114,19 +155,11 @@ void main() {
     }
   }
   if (wet == 0) discard;
-  vec3 view = normalize(v_world - frame.camera_pos.xyz);
-  vec3 normal = normalize(cross(u_glass_v, u_glass_u));  // out of the car
-  mat3 dir_of = mat3(u_glass_u, u_glass_v, normal);
-  vec3 eye = vec3(dot(view, u_glass_u), dot(view, u_glass_v), dot(view, normal));
-  vec3 w = refract(eye, vec3(0.0, 0.0, -1.0), 1.0 / u_water_ior);
+  WaterRay ray = water_ray();
   float n = float(u_samples);
   float spacing = max(length(dx), length(dy)) * inversesqrt(n);
   vec3 sum = vec3(0.0);
-  for (int k = 0; k < wet; ++k) sum += through_water(at[k], top[k], w, spacing, dir_of);
-  float coverage = float(wet) / n;
-  // Premultiplied over the view, which the composite adds as it is displayed: what the pixel
-  // shows is the display of the light's mean, water and the glass beside it mixed as light.
-  vec3 behind = textureLod(view_colour_tex, view_uv, 0.0).rgb;
-  vec3 shown = to_display((sum + (n - float(wet)) * from_display(behind)) / n);
-  out_colour = vec4(max(shown - (1.0 - coverage) * behind, 0.0), coverage);
+  for (int k = 0; k < wet; ++k) sum += through_water(at[k], top[k], ray.w, spacing, ray.dir_of);
+  out_colour = layer_pixel(sum, wet, n);
 }
+#endif

@@ -34,7 +34,8 @@ GlassWaterPass::Optics::Optics(const char* fragment_file, bool sharp,
 GlassWaterPass::GlassWaterPass(SharedResources&, GlassWaterConfig config)
     : config_(config),
       sharp_("glass_water.frag", true, config_),
-      blurred_("glass_water_blurred.frag", false, config_) {}
+      blurred_("glass_water_blurred.frag", false, config_),
+      pair_("glass_water_pair.frag", false, config_) {}
 
 bool GlassWaterPass::wanted(const FrameContext& frame) const {
   // (The blades alone still need the glass layer, which this pass makes: the composite draws them.)
@@ -43,7 +44,9 @@ bool GlassWaterPass::wanted(const FrameContext& frame) const {
 
 void GlassWaterPass::execute(const FrameContext& frame, const FrameResources& resources) {
   const int scale = std::clamp(frame.glass.layer_scale(), 1, 4);
-  const Optics& o = scale > 1 ? blurred_ : sharp_;
+  const int wanted_samples = config_.samples_by_scale[scale - 1];
+  const int samples = wanted_samples >= 16 ? 16 : wanted_samples >= 4 ? 4 : 2;
+  const Optics& o = scale == 1 ? sharp_ : samples == 2 ? pair_ : blurred_;
   o.program->use();
   o.grid.set(frame.water());
   const int face = std::max(resources.environment.width, 1);
@@ -56,8 +59,7 @@ void GlassWaterPass::execute(const FrameContext& frame, const FrameResources& re
   if (&o == &sharp_) o.glass_depth.set(frame.glass.depth_over_image());
   o.view_pixel_rad.set(2.0f * static_cast<float>(frame.camera.tan_half_fov_y) /
                        static_cast<float>(std::max(frame.spec.height, 1)));
-  const int samples = config_.samples_by_scale[scale - 1];
-  o.samples.set(samples >= 16 ? 16 : samples >= 4 ? 4 : 2);
+  o.samples.set(samples);
   o.inv_target.set(1.0f / glm::vec2(resources.glass_layer.width, resources.glass_layer.height));
   o.quad.draw(frame);  // also the glass's axes, for the rays' frame
 }

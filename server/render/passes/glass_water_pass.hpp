@@ -48,8 +48,8 @@ class GlassWaterPass final : public Pass {
                        // Only where GlassWaterMaskPass found that water may be.
                        {DepthTest::kNearer, false, Blend::kOff},
                        true};
-  // A program of the optics and its uniforms: the sharp one (a pinhole's full-size layer) and the
-  // blurred one (glass_water.glsl).
+  // A program of the optics and its uniforms: the sharp one (a pinhole's full-size layer), the
+  // blurred one, and the blurred one for a pair of samples a pixel (glass_water.glsl).
   struct Optics {
     Optics(const char* fragment_file, bool sharp, const GlassWaterConfig& config);
     std::unique_ptr<ShaderProgram> program;  // (where the quad's uniforms point)
@@ -59,7 +59,7 @@ class GlassWaterPass final : public Pass {
     Uniform inv_target, samples;
   };
   GlassWaterConfig config_;
-  Optics sharp_, blurred_;
+  Optics sharp_, blurred_, pair_;
 };
 
 }  // namespace downpour::render
