@@ -8,7 +8,7 @@
 namespace downpour::render {
 
 GlassView::GlassView(const Camera& camera, const sim::GlassConfig& glass, int image_height,
-                     int min_layer_scale)
+                     int min_layer_scale, double layer_widening)
     : glass_(glass),
       origin_(camera.position_vehicle),
       axes_(camera.axes_vehicle),
@@ -16,6 +16,7 @@ GlassView::GlassView(const Camera& camera, const sim::GlassConfig& glass, int im
       tan_y_(camera.tan_half_fov_y),
       near_m_(camera.near_m),
       min_layer_scale_(min_layer_scale),
+      layer_widening_(std::max(layer_widening, 1.0)),
       pinhole_(camera.aperture_mm <= 0.0) {
   const glm::dvec3 n = glass_.normal();
   const double facing = glm::dot(axes_[0], n);
@@ -64,6 +65,14 @@ int GlassView::layer_scale() const {
   if (pinhole_) return 1;
   return std::clamp(static_cast<int>(std::lround(blur_px())), std::clamp(min_layer_scale_, 1, 4),
                     4);
+}
+
+glm::ivec2 GlassView::layer_size(int width, int height) const {
+  const int scale = layer_scale();
+  const bool widened = !pinhole_ && std::lround(blur_px()) >= 2;
+  const double across = widened ? scale * layer_widening_ : scale;
+  return {std::max(1, static_cast<int>(std::ceil(width / across - 1e-9))),
+          std::max(1, (height + scale - 1) / scale)};
 }
 
 }  // namespace downpour::render

@@ -21,8 +21,10 @@ class GlassView {
   GlassView() = default;  // a view that does not look through the glass
   // min_layer_scale: the least reduction of the water layer where the lens blurs at all (a
   // renderer without a GPU pays for every pixel of it; a pinhole's layer is always full size).
+  // layer_widening: how much wider than tall the layer's pixels are where the blur itself spans
+  // two pixels or more (layer_size).
   GlassView(const Camera& camera, const sim::GlassConfig& glass, int image_height,
-            int min_layer_scale = 1);
+            int min_layer_scale = 1, double layer_widening = 1.0);
 
   // The glass-space point (mm) where the ray through image point (x right, y up, both in [-1, 1]
   // across the image) meets the glass's plane in front of the camera; none if it does not.
@@ -45,6 +47,12 @@ class GlassView {
   // blur (the bilinear upsampling then blurs as much), 1 (sharp) to 4; no less than the minimum
   // unless the lens is a pinhole.
   int layer_scale() const;
+  // The water layer's size for an image of width x height: 1 / layer_scale of its height, and of
+  // its width too, but for the widening where the blur itself spans two pixels or more. (The raked
+  // glass is seen foreshortened up the screen, twice over at the default rake: a drop's image is
+  // wider than tall, and what it shows turned over, ground above and sky below, lies up it. A
+  // renderer without a GPU gives up a little of the blur's sharpness across to keep it up.)
+  glm::ivec2 layer_size(int width, int height) const;
 
  private:
   sim::GlassConfig glass_;
@@ -56,6 +64,7 @@ class GlassView {
   double pixels_per_mm_ = 0.0;
   double blur_mm_ = 0.0;
   int min_layer_scale_ = 1;
+  double layer_widening_ = 1.0;
   bool pinhole_ = false;
 };
 

@@ -240,6 +240,23 @@ TEST_F(GlassPassesTest, EachLensBlursTheGlassByItsCircleOfConfusion) {
   EXPECT_NEAR(large.blur_px(), 3.0 * small.blur_px(), 1e-6);
   EXPECT_LE(small.layer_scale(), large.layer_scale());
   EXPECT_EQ(large.layer_scale(), 4);
+  // A widened layer (llvmpipe's) has wider pixels across only where the blur itself spans two
+  // pixels or more; never a pinhole's, nor where the layer is reduced for the renderer's sake.
+  const auto widened = [&](int width, int height, double aperture_mm) {
+    sim::ViewSpec spec = view_spec(sim::View::kCockpit, width, height);
+    spec.aperture_mm = aperture_mm;
+    return GlassView(make_camera(spec, dry_scene().vehicle), glass, spec.height, 2, 1.25);
+  };
+  const GlassView blurred = widened(1280, 720, 4.0);
+  ASSERT_GE(blurred.blur_px(), 2.0);
+  const int s = blurred.layer_scale();
+  EXPECT_EQ(blurred.layer_size(1280, 720),
+            glm::ivec2(static_cast<int>(std::ceil(1280.0 / (1.25 * s))), (720 + s - 1) / s));
+  const GlassView slight = widened(640, 360, 1.0);
+  ASSERT_LT(slight.blur_px(), 1.5);
+  EXPECT_EQ(slight.layer_size(640, 360), glm::ivec2(320, 180));
+  EXPECT_EQ(widened(1280, 720, 0.0).layer_size(1280, 720), glm::ivec2(1280, 720));
+  EXPECT_EQ(large.layer_size(1920, 1080), glm::ivec2(480, 270));  // (a GPU's: square)
 
   // The dash camera's view is its own, and its drops change the image.
   const sim::WindshieldState water = testing::rainy_windshield(glass, 3000);
