@@ -72,7 +72,7 @@ constexpr Ceiling kCeilings[] = {
     {"sky", 1.6, "sky and clouds"},
     {"glass", 5.0, "windshield: all its passes, the environment's mean (issue 27: 10 at 1280x720)"},
     {"glass_environment", -1.0,
-     "windshield: the world outside the glass, a face every 4 ticks (mean)"},
+     "windshield: the world outside the glass, a face every 6 ticks (mean)"},
     {"glass_water_mask", -1.0, "windshield: where water may be, in the glass layer's depth"},
     {"glass_water", -1.0,
      "windshield: the traced optics where the mask lets them (and the upload)"},

@@ -29,8 +29,10 @@ struct Atmosphere;
 struct EnvironmentConfig {
   int face_size = 128;  // texels a side: some 0.9 degrees each at a face's centre
   // A face is redrawn every this many ticks (the world passes cost llvmpipe some 4 ms a face: their
-  // draws, not their pixels): the front every other time, the others in turn between.
-  int ticks_per_face = 4;
+  // draws, not their pixels): the front every other time, the others in turn between. At 30 ticks
+  // a second the front is at most 0.4 s old, the ground, sides and sky 1.6 s: a lens's image of
+  // them is a few pixels, blurred by the pupil.
+  int ticks_per_face = 6;
   // The probe's centre: this far out from the glass's centre along its normal (m).
   float clearance_m = 0.05f;
 };
