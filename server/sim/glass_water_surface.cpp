@@ -68,44 +68,58 @@ void GlassWaterSurface::index(const GlassConfig& glass) {
   cells_v = std::max(1, static_cast<int>(std::ceil(glass.height_mm / kCellMm)));
   const std::size_t n_cells = static_cast<std::size_t>(cells_u) * cells_v;
   const float cell = static_cast<float>(kCellMm);
-  const float half_diagonal = cell * std::sqrt(0.5f);
-  // Every (cell, body) where the body's outline may reach the cell: the cells whose centre lies
-  // within its widest reach of the body's centre line, and half a cell's diagonal more; and the
-  // cells whose centre lies within a body's outline, wet. (Scratch kept by the thread: the step
-  // publishes a surface a tick.)
-  thread_local std::vector<std::uint64_t> pairs;
-  thread_local std::vector<std::uint32_t> fill;
-  thread_local std::vector<std::uint8_t> wet;
-  pairs.clear();
-  pairs.reserve(bodies.size() * 9);
+  // Every (cell, body) where the cell overlaps the box around the body's outline (in the frame of
+  // its axis: from back_mm behind its segment's start to front_mm beyond its end, side_mm either
+  // side), and the cells whose centre lies within a body's outline, wet. A point under water lies
+  // in a cell that lists its body; a drop of 1 mm radius is listed in 2.25 cells on average. (The
+  // scratch is kept by the thread, bound once to references: each use of a thread_local with a
+  // constructor goes through its guard. The wet test has no branch: which cells pass is noise to a
+  // branch predictor.)
+  thread_local std::vector<std::uint64_t> tls_pairs;
+  thread_local std::vector<std::uint32_t> tls_fill;
+  thread_local std::vector<std::uint8_t> tls_wet;
+  std::vector<std::uint64_t>& pairs = tls_pairs;
+  std::vector<std::uint32_t>& fill = tls_fill;
+  std::vector<std::uint8_t>& wet = tls_wet;
+  std::size_t n_pairs = 0;
   wet.assign(n_cells, 0);
+  std::uint8_t* const wet_cells_of = wet.data();
   for (std::size_t k = 0; k < bodies.size(); ++k) {
-    const WaterBody b = bodies[k];  // (a copy: the pushes below cannot alias it)
-    const float wide = std::max({b.side_mm, b.front_mm, b.back_mm}) + half_diagonal;
-    const float wide2 = wide * wide, half = b.half_length_mm;
-    const float reach = half + wide;
-    const int i0 = std::max(0, static_cast<int>((b.u_mm - reach) / cell));
-    const int i1 = std::min(cells_u - 1, static_cast<int>((b.u_mm + reach) / cell));
-    const int j0 = std::max(0, static_cast<int>((b.v_mm - reach) / cell));
-    const int j1 = std::min(cells_v - 1, static_cast<int>((b.v_mm + reach) / cell));
+    const WaterBody b = bodies[k];  // (a copy: the byte stores below may alias a reference)
+    // The box's centre and half extents over the glass.
+    const float shift = 0.5f * (b.front_mm - b.back_mm);
+    const float along = b.half_length_mm + 0.5f * (b.front_mm + b.back_mm);
+    const float au = std::abs(b.axis_u), av = std::abs(b.axis_v);
+    const float cu = b.u_mm + shift * b.axis_u, cv = b.v_mm + shift * b.axis_v;
+    const float eu = au * along + av * b.side_mm, ev = av * along + au * b.side_mm;
+    const int i0 = std::max(0, static_cast<int>(std::floor((cu - eu) / cell)));
+    const int i1 = std::min(cells_u - 1, static_cast<int>(std::floor((cu + eu) / cell)));
+    const int j0 = std::max(0, static_cast<int>(std::floor((cv - ev) / cell)));
+    const int j1 = std::min(cells_v - 1, static_cast<int>(std::floor((cv + ev) / cell)));
+    if (i1 < i0 || j1 < j0) continue;
+    const std::size_t listed = static_cast<std::size_t>(i1 - i0 + 1) * (j1 - j0 + 1);
+    if (pairs.size() < n_pairs + listed)
+      pairs.resize(std::max(2 * pairs.size(), n_pairs + listed + 4096));
+    std::uint64_t* const out = pairs.data();
+    const float half = b.half_length_mm, inv_side = 1.0f / b.side_mm;
+    const float inv_front = 1.0f / b.front_mm, inv_back = 1.0f / b.back_mm;
     for (int j = j0; j <= j1; ++j) {
       const float dv = (static_cast<float>(j) + 0.5f) * cell - b.v_mm;
       for (int i = i0; i <= i1; ++i) {
         const float du = (static_cast<float>(i) + 0.5f) * cell - b.u_mm;
-        // Beyond the centre segment's ends (x) and across it (y): body_rho2's frame.
-        const float along = du * b.axis_u + dv * b.axis_v, y = dv * b.axis_u - du * b.axis_v;
-        const float x = along - std::clamp(along, -half, half);
-        if (x * x + y * y > wide2) continue;
         const int c = j * cells_u + i;
-        pairs.push_back(static_cast<std::uint64_t>(c) << 32 | k);
-        const float qx = x / (x >= 0.0f ? b.front_mm : b.back_mm), qy = y / b.side_mm;
-        if (qx * qx + qy * qy < 1.0f) wet[static_cast<std::size_t>(c)] = 1;
+        out[n_pairs++] = static_cast<std::uint64_t>(c) << 32 | k;
+        // The cell's centre in body_rho2's frame: beyond the segment's ends (x), across it (y).
+        const float a = du * b.axis_u + dv * b.axis_v, y = dv * b.axis_u - du * b.axis_v;
+        const float x = a - std::clamp(a, -half, half);
+        const float qx = x * (x >= 0.0f ? inv_front : inv_back), qy = y * inv_side;
+        wet_cells_of[c] |= static_cast<std::uint8_t>(qx * qx + qy * qy < 1.0f);
       }
     }
   }
   // A counting sort by cell (the pairs of a cell keep their bodies' order).
   cells.assign(n_cells, 0);
-  for (const std::uint64_t pair : pairs) ++cells[pair >> 32];
+  for (std::size_t p = 0; p < n_pairs; ++p) ++cells[pairs[p] >> 32];
   std::uint32_t first = 0;
   constexpr std::uint32_t kMaxCount = (1u << kCountBits) - 1;
   fill.resize(n_cells);
@@ -115,9 +129,9 @@ void GlassWaterSurface::index(const GlassConfig& glass) {
     cells[c] = first << kCountBits | std::min(count, kMaxCount);
     first += count;
   }
-  entries.resize(pairs.size());
-  for (const std::uint64_t pair : pairs)
-    entries[fill[pair >> 32]++] = static_cast<std::uint32_t>(pair & 0xffffffffu);
+  entries.resize(n_pairs);
+  for (std::size_t p = 0; p < n_pairs; ++p)
+    entries[fill[pairs[p] >> 32]++] = static_cast<std::uint32_t>(pairs[p] & 0xffffffffu);
   // The wet cells' centres over those within the glass's outline ([inset, width - inset] a row).
   std::size_t glass_cells = 0, wet_cells = 0;
   for (int j = 0; j < cells_v; ++j) {

@@ -106,6 +106,12 @@ TEST(GlassWaterSurfaceTest, EveryPointOfABodyIsListedInItsCell) {
   EXPECT_TRUE(listed(one, 0, {50.5 * c, 50.5 * c}));
   EXPECT_FALSE(listed(one, 0, {53.0 * c, 50.5 * c}));
   EXPECT_EQ(one.entries.size(), 9u);
+  // A drop of 1 mm radius inside a cell is listed there alone; across a corner, in its 4 cells.
+  GlassWaterSurface small;
+  small.bodies.push_back(cap_body({50.5f * c, 50.5f * c}, 1.0f, 40.0));
+  small.bodies.push_back(cap_body({60.0f * c, 60.0f * c}, 1.0f, 40.0));
+  small.index(glass);
+  EXPECT_EQ(small.entries.size(), 5u);
 }
 
 TEST(GlassWaterSurfaceTest, WhereTheWaterIsAndHowMuchOfTheGlassItWets) {
