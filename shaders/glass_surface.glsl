@@ -87,6 +87,13 @@ WaterSurface body_surface(Body b, vec2 p) {
   return WaterSurface(h, dh * o.drho, abs(d2h) / (r * r * g * sqrt(g)));
 }
 
+// The blurred layer's usual pair of samples of a pixel whose footprint on the glass has sides dx
+// and dy: a diagonal pair, a quarter of the footprint either side of its centre.
+void pair_samples(vec2 centre, vec2 dx, vec2 dy, out vec2 p0, out vec2 p1) {
+  p0 = centre - 0.25 * (dx + dy);
+  p1 = centre + 0.25 * (dx + dy);
+}
+
 // The listing of the grid cell under glass point p: first entry << u_count_bits | count (0 off the
 // grid).
 uint cell_listing(vec2 p) {

@@ -118,7 +118,8 @@ vec4 layer_pixel(vec3 sum, int wet, float n) {
 // a lane at a time, where an index is not known when compiled).
 void main() {
   vec2 dx = dFdx(v_glass_mm), dy = dFdy(v_glass_mm);  // the pixel's footprint on the glass, mm
-  vec2 p0 = v_glass_mm - 0.25 * (dx + dy), p1 = v_glass_mm + 0.25 * (dx + dy);
+  vec2 p0, p1;
+  pair_samples(v_glass_mm, dx, dy, p0, p1);
   uint b0, b1;
   bool w0 = water_top(p0, b0), w1 = water_top(p1, b1);
   if (!(w0 || w1)) discard;

@@ -752,8 +752,9 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   impl->rain = rain;
   Pass* rain_mask = impl->add<RainMaskPass>();
   Pass* environment_background = impl->add<EnvironmentBackgroundPass>();
-  Pass* glass_water_mask = impl->add<GlassWaterMaskPass>();
-  Pass* glass_water = impl->add<GlassWaterPass>();
+  GlassWaterPass* glass_water = impl->add<GlassWaterPass>();
+  impl->passes.push_back(std::make_unique<GlassWaterMaskPass>(*impl->shared, *glass_water));
+  Pass* glass_water_mask = impl->passes.back().get();
   Pass* glass_composite = impl->add<GlassCompositePass>();
   Pass* windshield = impl->add<WindshieldPass>();
   SprayPass* spray = impl->add<SprayPass>();

@@ -1,18 +1,28 @@
 #include "server/render/passes/glass_water_mask_pass.hpp"
 
+#include <algorithm>
+
+#include "server/render/passes/glass_water_pass.hpp"
+
 namespace downpour::render {
 
-GlassWaterMaskPass::GlassWaterMaskPass(SharedResources&)
-    : program_("glass.vert", "glass_water_mask.frag"), quad_(program_), grid_(program_) {}
+GlassWaterMaskPass::Mask::Mask(const char* fragment_file)
+    : program(std::make_unique<ShaderProgram>("glass.vert", fragment_file)),
+      quad(*program),
+      grid(*program) {}
+
+GlassWaterMaskPass::GlassWaterMaskPass(SharedResources&, const GlassWaterPass& optics)
+    : optics_(optics), footprint_("glass_water_mask.frag"), pair_("glass_water_mask_pair.frag") {}
 
 bool GlassWaterMaskPass::wanted(const FrameContext& frame) const {
   return glass_has_water_or_blades(frame.water());  // as GlassWaterPass
 }
 
 void GlassWaterMaskPass::execute(const FrameContext& frame, const FrameResources&) {
-  program_.use();
-  grid_.set(frame.water());
-  quad_.draw(frame);
+  const Mask& m = optics_.pair(std::clamp(frame.glass.layer_scale(), 1, 4)) ? pair_ : footprint_;
+  m.program->use();
+  m.grid.set(frame.water());
+  m.quad.draw(frame);
 }
 
 }  // namespace downpour::render

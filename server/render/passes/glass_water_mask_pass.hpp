@@ -1,18 +1,25 @@
 #pragma once
 
+#include <memory>
+
 #include "server/render/glass_quad.hpp"
 #include "server/render/pass.hpp"
 
 namespace downpour::render {
 
-// Where the glass layer's optics may meet water: the layer's pixels whose footprint touches a
-// cell of the surface's grid that lists a body (glass_water_mask.frag), marked in the layer's
-// depth (cleared to the nearest): the farthest depth there. GlassWaterPass, depth-tested nearer,
+class GlassWaterPass;
+
+// Where the glass layer's optics may meet water, marked in the layer's depth (cleared to the
+// nearest): the farthest depth there. For the optics' pair of samples, the pixels where a cell
+// under one of the two lists a body (glass_water_mask_pair.frag: the cells the pair's search
+// walks, two fetches); for their grids of 4 or 16, the pixels whose footprint touches such a cell
+// (glass_water_mask.frag, five). GlassWaterPass, depth-tested nearer,
 // then runs only there: llvmpipe skips a block of pixels that all fail the depth test, where it
 // cannot skip a branch (on a wiped glass most of the layer is dry). Colour is left alone.
 class GlassWaterMaskPass final : public Pass {
  public:
-  explicit GlassWaterMaskPass(SharedResources& shared);
+  // `optics`: the pass it masks, which says which samples a layer scale takes.
+  GlassWaterMaskPass(SharedResources& shared, const GlassWaterPass& optics);
   const PassDecl& decl() const override { return decl_; }
   bool wanted(const FrameContext& frame) const override;
   void execute(const FrameContext& frame, const FrameResources& resources) override;
@@ -23,9 +30,14 @@ class GlassWaterMaskPass final : public Pass {
                        {Resource::kGlassLayer},
                        {DepthTest::kAlways, true, Blend::kOff, false},
                        true};
-  ShaderProgram program_;
-  GlassQuad quad_;
-  GlassSurfaceGrid grid_;
+  struct Mask {
+    explicit Mask(const char* fragment_file);
+    std::unique_ptr<ShaderProgram> program;  // (where the quad's uniforms point)
+    GlassQuad quad;
+    GlassSurfaceGrid grid;
+  };
+  const GlassWaterPass& optics_;
+  Mask footprint_, pair_;
 };
 
 }  // namespace downpour::render

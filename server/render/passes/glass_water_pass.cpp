@@ -42,11 +42,15 @@ bool GlassWaterPass::wanted(const FrameContext& frame) const {
   return glass_has_water_or_blades(frame.water());
 }
 
+int GlassWaterPass::samples(int layer_scale) const {
+  const int wanted = config_.samples_by_scale[std::clamp(layer_scale, 1, 4) - 1];
+  return wanted >= 16 ? 16 : wanted >= 4 ? 4 : 2;
+}
+
 void GlassWaterPass::execute(const FrameContext& frame, const FrameResources& resources) {
   const int scale = std::clamp(frame.glass.layer_scale(), 1, 4);
-  const int wanted_samples = config_.samples_by_scale[scale - 1];
-  const int samples = wanted_samples >= 16 ? 16 : wanted_samples >= 4 ? 4 : 2;
-  const Optics& o = scale == 1 ? sharp_ : samples == 2 ? pair_ : blurred_;
+  const int samples = this->samples(scale);
+  const Optics& o = scale == 1 ? sharp_ : pair(scale) ? pair_ : blurred_;
   o.program->use();
   o.grid.set(frame.water());
   const int face = std::max(resources.environment.width, 1);

@@ -39,6 +39,10 @@ class GlassWaterPass final : public Pass {
   const PassDecl& decl() const override { return decl_; }
   bool wanted(const FrameContext& frame) const override;
   void execute(const FrameContext& frame, const FrameResources& resources) override;
+  // The optics' samples a layer pixel at this layer scale (2, 4 or 16), and whether they are the
+  // pair (glass_water_pair.frag, whose mask tests the pair's own cells).
+  int samples(int layer_scale) const;
+  bool pair(int layer_scale) const { return layer_scale > 1 && samples(layer_scale) == 2; }
 
  private:
   const PassDecl decl_{"glass_water",
