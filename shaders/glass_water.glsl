@@ -1,6 +1,6 @@
 // The water on the windshield as the view sees it (glass_water_pass.hpp), shared by its programs:
 // glass_water.frag (sharp: the view's own image for rays that barely turn, three Newton steps),
-// glass_water_blurred.frag (GLASS_BLURRED: the environment alone, two steps) and
+// glass_water_blurred.frag (GLASS_BLURRED: the environment alone, one step) and
 // glass_water_pair.frag (blurred, and GLASS_PAIR: two samples a pixel, known when compiled).
 // llvmpipe pays for every instruction of a shader on every pixel, whatever its branches take, so
 // what a program can do without is left out of it, not skipped at run time.
@@ -22,7 +22,7 @@ uniform float u_view_pixel_rad;  // one pixel of the view, radians
 uniform vec2 u_inv_target;       // one layer pixel in the view's uv
 
 #ifdef GLASS_BLURRED
-const int kNewtonSteps = 2;  // the lens's blur hides the rest
+const int kNewtonSteps = 1;  // the tangent plane's hit: the lens's blur hides the rest
 #else
 const int kNewtonSteps = 3;
 #endif
