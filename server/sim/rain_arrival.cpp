@@ -7,7 +7,7 @@
 #include <glm/geometric.hpp>
 
 #include "server/sim/drop_physics.hpp"
-#include "server/sim/water.hpp"
+#include "server/sim/water_inputs.hpp"
 
 namespace downpour::sim {
 namespace {

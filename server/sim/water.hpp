@@ -20,18 +20,10 @@
 #include "server/sim/mesh_model.hpp"
 #include "server/sim/particle_model.hpp"
 #include "server/sim/rain_arrival.hpp"
+#include "server/sim/water_inputs.hpp"
 #include "server/sim/windshield.hpp"
 
 namespace downpour::sim {
-
-struct WaterInputs {
-  double rain_rate_mm_h = 0.0;
-  // Rain's velocity relative to the glass, vehicle frame, without the fall: wind minus the car's
-  // own velocity (m/s). The fall (terminal speed) is added per drop size.
-  glm::dvec3 air_velocity_mps{0.0};
-  std::array<BladePose, 2> blades_before;  // at the start of the step
-  std::array<BladePose, 2> blades_after;   // at its end
-};
 
 // Where the water went, mg: arrived = on the glass + wiped_off + drained + evaporated.
 struct WaterLedger {
