@@ -1,10 +1,11 @@
-// The static world built once for a road network: road surface and terrain, split into chunks
-// that the passes cull against the camera's view. No GL.
+// The static world built once for a road network: road surface, terrain and street lights, split
+// into chunks that the passes cull against the camera's view. No GL.
 #pragma once
 
 #include <vector>
 
 #include "server/render/mesh_data.hpp"
+#include "server/sim/lights.hpp"
 #include "server/sim/road_network.hpp"
 
 namespace downpour::render {
@@ -22,6 +23,10 @@ std::vector<std::vector<MeshData>> build_road_chunks(const sim::RoadNetwork& roa
 // at four levels of detail (cells of 20, 40, 80 and 160 m over the same grid) with skirts that hide
 // the cracks between neighbours drawn at different levels.
 std::vector<std::vector<MeshData>> build_terrain_chunks(const sim::RoadNetwork& roads);
+
+// The street lights' meshes (street_light_pass.hpp), four poles a chunk (one level of detail).
+std::vector<std::vector<MeshData>> build_street_light_chunks(
+    const std::vector<sim::StreetLight>& lights);
 
 // Terrain height at a world position (also used by tests and scenery placement).
 double terrain_height(const sim::RoadNetwork& roads, double x, double y);

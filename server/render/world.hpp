@@ -1,7 +1,7 @@
 // What the renderer draws of the roads a session drives on (sim/road_network.hpp): the road and
-// its verges, the terrain around, and the street lights. Made once for each road network, the
-// first time a frame shows it (from geometry prepared where the network was loaded, if it was),
-// and dropped once no session holds the network any more.
+// its verges, the terrain around, and the street lights, uploaded. Made once for each road
+// network, the first time a frame shows it (from geometry prepared where the network was loaded,
+// if it was: world_geometry.hpp), and dropped once no session holds the network any more.
 #pragma once
 
 #include <memory>
@@ -9,23 +9,13 @@
 
 #include "server/render/chunked_mesh.hpp"
 #include "server/render/gl_objects.hpp"
-#include "server/render/mesh_data.hpp"
-#include "server/sim/lights.hpp"
-#include "server/sim/road_network.hpp"
+#include "server/render/world_geometry.hpp"
 
 namespace downpour::render {
 
-// What is built of a network on the CPU (no GL): where a session's network is loaded
-// (prepare_world, on the request's thread), so that the render loop only uploads it.
-struct WorldGeometry {
-  std::vector<sim::StreetLight> street_lights;  // sim/lights.hpp
-  std::vector<std::vector<MeshData>> road, terrain, poles;
-  double build_ms = 0.0;
-};
-WorldGeometry build_world_geometry(const sim::RoadNetwork& roads);
-// Builds a network's geometry ahead of its first frame (once; thread-safe). Kept until the
-// renderer takes it, or the network goes.
-void prepare_world(const std::shared_ptr<const sim::RoadNetwork>& roads);
+// Street lights farther than this are not drawn (a pole there is a fifth of a pixel wide at 640 x
+// 360; at night the lamp_glow pass still draws its lens), times the frame's detail distance scale.
+inline constexpr float kStreetLightsDrawnWithin_m = 350.0f;
 
 struct World {
   std::vector<sim::StreetLight> street_lights;  // sim/lights.hpp

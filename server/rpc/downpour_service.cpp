@@ -9,7 +9,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "server/render/world.hpp"
+#include "server/render/world_geometry.hpp"
 #include "server/rpc/convert.hpp"
 #include "server/session/latest_frame_slot.hpp"
 

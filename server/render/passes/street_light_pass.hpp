@@ -5,14 +5,12 @@
 
 namespace downpour::render {
 
-// The roads' street lights (sim/lights.hpp; their meshes in world.hpp): a pole on the verge, an arm
-// over the road and a lamp at its end, whose lens glows when the lights are on (their light on the
-// ground is the lamp map's). Static geometry in chunks of four poles, culled against the view and
-// beyond kStreetLightsDrawnWithin_m (a pole there is a fifth of a pixel wide at 640 x 360; at night
-// the lamp_glow pass still draws its lens) times the frame's detail distance scale (the road's
-// mirror, at a quarter of the size, stops at a quarter of it); mirrored in the wet road with the
-// cars.
-inline constexpr float kStreetLightsDrawnWithin_m = 350.0f;
+// The roads' street lights (sim/lights.hpp; their meshes built in scene_geometry.hpp, kept in
+// world.hpp): a pole on the verge, an arm over the road and a lamp at its end, whose lens glows
+// when the lights are on (their light on the ground is the lamp map's). Static geometry in chunks
+// of four poles, culled against the view and beyond kStreetLightsDrawnWithin_m (world.hpp) times
+// the frame's detail distance scale (the road's mirror, at a quarter of the size, stops at a
+// quarter of it); mirrored in the wet road with the cars.
 class StreetLightPass final : public Pass {
  public:
   explicit StreetLightPass(SharedResources& shared);
@@ -27,9 +25,5 @@ class StreetLightPass final : public Pass {
   ShaderProgram program_;
   Uniform u_head_;
 };
-
-// The street lights' meshes, four poles a chunk (one level of detail).
-std::vector<std::vector<MeshData>> build_street_light_chunks(
-    const std::vector<sim::StreetLight>& lights);
 
 }  // namespace downpour::render
