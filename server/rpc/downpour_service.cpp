@@ -51,6 +51,17 @@ grpc::Status may_watch(const Principal& who, const Session& s) {
                           "viewer role");
 }
 
+// The session that `id` (already checked) names, where `who` may reach it as `access` says
+// (may_drive, may_watch): NOT_FOUND where there is none, or access's refusal.
+grpc::Status reach_session(const session::SessionRegistry& registry, const std::string& id,
+                           const Principal& who,
+                           grpc::Status (*access)(const Principal&, const Session&),
+                           std::shared_ptr<Session>* session) {
+  *session = registry.find(id);
+  if (!*session) return not_found(id);
+  return access(who, **session);
+}
+
 const grpc::Status kDraining(grpc::StatusCode::UNAVAILABLE,
                              "server shutting down: it takes no new sessions or steps");
 
@@ -238,9 +249,9 @@ class DriveReactor final : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc
     }
     if (!session) {
       if (auto s = check_session_id(req.session_id(), "session_id"); !s.ok()) return s;
-      session = ctx_.registry.find(req.session_id());
-      if (!session) return not_found(req.session_id());
-      if (auto s = may_drive(who_, *session); !s.ok()) return s;
+      if (auto s = reach_session(ctx_.registry, req.session_id(), who_, may_drive, &session);
+          !s.ok())
+        return s;
       {
         std::lock_guard lock(mutex_);
         session_ = session;
@@ -544,9 +555,10 @@ grpc::ServerUnaryReactor* DownpourService::CloseSession(grpc::CallbackServerCont
   if (auto s = context_.auth.authenticate(*ctx, &who); !s.ok()) return finish(ctx, s);
   if (auto s = check_session_id(request->session_id(), "session_id"); !s.ok())
     return finish(ctx, s);
-  const auto session = context_.registry.find(request->session_id());
-  if (!session) return finish(ctx, not_found(request->session_id()));
-  if (auto s = may_drive(who, *session); !s.ok()) return finish(ctx, s);
+  std::shared_ptr<Session> session;
+  if (auto s = reach_session(context_.registry, request->session_id(), who, may_drive, &session);
+      !s.ok())
+    return finish(ctx, s);
   if (!context_.registry.close(request->session_id()))
     return finish(ctx, not_found(request->session_id()));
   spdlog::info("session {} ended: {} frames, sim time {:.2f} s", session->id(),
@@ -580,9 +592,10 @@ grpc::ServerUnaryReactor* DownpourService::Update(grpc::CallbackServerContext* c
   sim::Update update;
   if (auto s = to_update(request->update(), "update", context_.limits, &update); !s.ok())
     return finish(ctx, s);
-  const auto session = context_.registry.find(request->session_id());
-  if (!session) return finish(ctx, not_found(request->session_id()));
-  if (auto s = may_drive(who, *session); !s.ok()) return finish(ctx, s);
+  std::shared_ptr<Session> session;
+  if (auto s = reach_session(context_.registry, request->session_id(), who, may_drive, &session);
+      !s.ok())
+    return finish(ctx, s);
   session->touch();
   response->set_sim_time_s(session->sim_time_s());
   return finish(ctx, submit_status(session->post_update(update), session->id()));
@@ -600,9 +613,10 @@ grpc::ServerUnaryReactor* DownpourService::Step(grpc::CallbackServerContext* ctx
     return finish(ctx, s);
   if (auto s = check_dt(request->dt_s(), "dt_s", false, context_.limits); !s.ok())
     return finish(ctx, s);
-  const auto session = context_.registry.find(request->session_id());
-  if (!session) return finish(ctx, not_found(request->session_id()));
-  if (auto s = may_drive(who, *session); !s.ok()) return finish(ctx, s);
+  std::shared_ptr<Session> session;
+  if (auto s = reach_session(context_.registry, request->session_id(), who, may_drive, &session);
+      !s.ok())
+    return finish(ctx, s);
   session->touch();
   if (session->config().mode != sim::Mode::kLockstep) {
     return finish(ctx, grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
@@ -652,9 +666,10 @@ grpc::ServerWriteReactor<v1::Frame>* DownpourService::WatchFrames(
   Principal who;
   if (auto s = context_.auth.authenticate(*ctx, &who); !s.ok()) return fail(s);
   if (auto s = check_session_id(request->session_id(), "session_id"); !s.ok()) return fail(s);
-  const auto session = context_.registry.find(request->session_id());
-  if (!session) return fail(not_found(request->session_id()));
-  if (auto s = may_watch(who, *session); !s.ok()) return fail(s);
+  std::shared_ptr<Session> session;
+  if (auto s = reach_session(context_.registry, request->session_id(), who, may_watch, &session);
+      !s.ok())
+    return fail(s);
   // Only the owner's own watching counts as hearing from its client; a viewer watching someone
   // else's session does not keep it alive once its driver has gone.
   if (who.name == session->config().owner) session->touch();
