@@ -1,38 +1,47 @@
 #include "server/render/pass.hpp"
 
 #include <algorithm>
+#include <iterator>
 #include <stdexcept>
+
+#include "server/render/shader_interface.hpp"
 
 namespace downpour::render {
 
-std::string_view resource_name(Resource r) {
-  switch (r) {
-    case Resource::kViewColour:
-      return "view colour";
-    case Resource::kViewDepth:
-      return "view depth";
-    case Resource::kGlassLayer:
-      return "glass layer";
-    case Resource::kGlassSurface:
-      return "glass water surface";
-    case Resource::kEnvironment:
-      return "environment";
-    case Resource::kRoadWater:
-      return "road water";
-    case Resource::kRoadReflection:
-      return "road reflection";
-    case Resource::kSprayLayer:
-      return "spray layer";
+namespace {
+
+constexpr ResourceInfo kResources[] = {
+    {Resource::kViewColour, "view colour", texture_unit::kViewColour, false, true},
+    {Resource::kViewDepth, "view depth", texture_unit::kViewDepth, false, true},
+    {Resource::kGlassLayer, "glass layer", texture_unit::kGlassLayer, false, false},
+    // (Three texture buffers at their own units: upload_glass_surface.)
+    {Resource::kGlassSurface, "glass water surface", 0, true, false},
+    {Resource::kEnvironment, "environment", texture_unit::kEnvironment, true, false},
+    {Resource::kRoadWater, "road water", texture_unit::kRoadWater, true, false},
+    {Resource::kRoadReflection, "road reflection", texture_unit::kReflection, true, false},
+    {Resource::kSprayLayer, "spray layer", texture_unit::kSprayLayer, false, false},
+};
+static_assert(std::size(kResources) == kResourceCount);
+constexpr bool in_order() {
+  for (std::size_t i = 0; i < kResourceCount; ++i) {
+    if (static_cast<std::size_t>(kResources[i].resource) != i) return false;
   }
-  return "?";
+  return true;
+}
+static_assert(in_order(), "kResources follows Resource's order");
+
+}  // namespace
+
+const ResourceInfo& resource_info(Resource r) {
+  return kResources[std::min(static_cast<std::size_t>(r), kResourceCount - 1)];
 }
 
 void check_pass_order(std::string_view view, const std::vector<Pass*>& passes) {
-  // The frame provides these from its start (the simulation's, or drawn before the passes).
-  const std::vector<Resource> provided = {Resource::kGlassSurface, Resource::kEnvironment,
-                                          Resource::kRoadWater, Resource::kRoadReflection};
-  std::vector<Resource> available = {Resource::kViewColour, Resource::kViewDepth};
-  available.insert(available.end(), provided.begin(), provided.end());
+  // The view's targets, and what the frame provides from its start.
+  std::vector<Resource> available;
+  for (const ResourceInfo& info : kResources) {
+    if (info.view_target || info.from_frame) available.push_back(info.resource);
+  }
   auto fail = [&](const PassDecl& d, std::string_view what, Resource r) {
     throw std::logic_error(std::string(view) + " view, pass " + d.name + ": " + std::string(what) +
                            " " + std::string(resource_name(r)));
@@ -43,16 +52,14 @@ void check_pass_order(std::string_view view, const std::vector<Pass*>& passes) {
       if (std::find(available.begin(), available.end(), r) == available.end())
         fail(d, "reads before anything writes", r);
     }
-    const bool to_view = std::all_of(d.writes.begin(), d.writes.end(), [](Resource r) {
-      return r == Resource::kViewColour || r == Resource::kViewDepth;
-    });
+    const bool to_view = std::all_of(d.writes.begin(), d.writes.end(),
+                                     [](Resource r) { return resource_info(r).view_target; });
     if (d.writes.empty() || (!to_view && d.writes.size() != 1)) {
       throw std::logic_error(std::string(view) + " view, pass " + d.name +
                              ": must write one target");
     }
     for (Resource r : d.writes) {
-      if (std::find(provided.begin(), provided.end(), r) != provided.end())
-        fail(d, "cannot write", r);
+      if (resource_info(r).from_frame) fail(d, "cannot write", r);
       available.push_back(r);
     }
   }

@@ -32,7 +32,17 @@ enum class Resource : std::uint8_t {
   kSprayLayer,  // the spray over the scene, half the view, premultiplied
 };
 inline constexpr std::size_t kResourceCount = 8;
-std::string_view resource_name(Resource resource);
+
+// What the renderer knows of each resource, in one table (pass.cpp).
+struct ResourceInfo {
+  Resource resource;
+  std::string_view name;
+  unsigned texture_unit;  // where a pass that reads it finds it (shader_interface.hpp)
+  bool from_frame;        // there from the frame's start (the simulation's, or drawn before)
+  bool view_target;       // the view's own colour or depth
+};
+const ResourceInfo& resource_info(Resource resource);
+inline std::string_view resource_name(Resource resource) { return resource_info(resource).name; }
 
 struct PassDecl {
   std::string name;

@@ -182,30 +182,6 @@ Mirror mirror_under(const sim::RoadNetwork& roads, const sim::VehicleState& vehi
   return mirror_in(glm::dvec4(n, -glm::dot(n, point)));
 }
 
-GLuint unit_of(Resource r) {
-  switch (r) {
-    case Resource::kViewColour:
-      return texture_unit::kViewColour;
-    case Resource::kViewDepth:
-      return texture_unit::kViewDepth;
-    case Resource::kGlassLayer:
-      return texture_unit::kGlassLayer;
-    case Resource::kGlassSurface:
-      return 0;  // three texture buffers (upload_glass_surface)
-    case Resource::kEnvironment:
-      return texture_unit::kEnvironment;
-    case Resource::kRoadWater:
-      return texture_unit::kRoadWater;
-    case Resource::kRoadReflection:
-      return texture_unit::kReflection;
-    case Resource::kSprayLayer:
-      return texture_unit::kSprayLayer;
-  }
-  return 0;
-}
-
-bool is_view_target(Resource r) { return r == Resource::kViewColour || r == Resource::kViewDepth; }
-
 // Water on the glass to refract the world outside (the blades alone need none of it).
 bool has_water(const sim::WindshieldState& water) {
   return water.surface && !water.surface->bodies.empty();
@@ -616,10 +592,10 @@ struct Renderer::Impl {
           texture = r.spray_layer.texture;
           break;
       }
-      glBindTextureUnit(unit_of(res), texture);
+      glBindTextureUnit(resource_info(res).texture_unit, texture);
     }
     const Resource out = d.writes.front();
-    if (is_view_target(out)) {
+    if (resource_info(out).view_target) {
       glBindFramebuffer(GL_FRAMEBUFFER, r.view_fbo);
       glViewport(0, 0, r.view_colour.width, r.view_colour.height);
     } else {
