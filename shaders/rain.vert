@@ -4,7 +4,8 @@
 // windshield's, so that the test keeps the rain off what is on the driver's side of the glass
 // without a depth per pixel, and with depth clamping, so that no part of a run is clipped where
 // the plane leaves [0, 1]. The others are drawn without a depth test.
-layout(std430, binding = 0) readonly buffer Runs {
+#include "interface.glsl"
+layout(std430, binding = RUNS_BUFFER) readonly buffer Runs {
   vec4 runs[];  // uv over the view: x0, y0, x1, y1
 };
 out vec2 v_uv;

@@ -2,7 +2,8 @@
 // Seed 001, step 3, on a GPU: each liquid parcel as a square facing the camera, in front of its
 // sphere and large enough to cover its outline; the fragment shader casts the pixel's ray at the
 // sphere. (On llvmpipe the CPU draws the same maps: spray_splat.hpp.)
-layout(std430, binding = 1) readonly buffer Parcels {
+#include "interface.glsl"
+layout(std430, binding = PARCELS_BUFFER) readonly buffer Parcels {
   vec4 parcels[];  // view-space centre, radius (m)
 };
 uniform mat4 u_projection;

@@ -1,7 +1,8 @@
 #version 450
 // The spray's haze on a GPU: each parcel's cloud of droplets as a square facing the camera. (On
 // llvmpipe the CPU draws the same map: spray_splat.hpp.)
-layout(std430, binding = 2) readonly buffer Haze {
+#include "interface.glsl"
+layout(std430, binding = HAZE_BUFFER) readonly buffer Haze {
   vec4 haze[];  // per parcel two: view-space centre, radius; x optical depth through the centre
 };
 uniform mat4 u_projection;

@@ -1,7 +1,8 @@
 #version 450
 // Runs of the spray layer's tiles (uv rectangles over the target, two triangles each): the passes
 // after the particles draw only where there is spray.
-layout(std430, binding = 0) readonly buffer Runs {
+#include "interface.glsl"
+layout(std430, binding = RUNS_BUFFER) readonly buffer Runs {
   vec4 runs[];  // x0, y0, x1, y1
 };
 uniform float u_depth;  // the runs' depth: what the mask holds less than it is not drawn

@@ -1,7 +1,7 @@
-// The interface between the C++ renderer and its shaders, defined once: texture units, the
-// per-frame uniform block (std140) and its binding. The build writes the GLSL side of it
-// (interface.glsl, made by downpour-shader-tool from these same lists), so that a binding number
-// or a block field cannot differ between the two. No GL.
+// The interface between the C++ renderer and its shaders, defined once: texture units, storage
+// buffers' bindings, the per-frame uniform block (std140) and its binding. The build writes the
+// GLSL side of it (interface.glsl, made by downpour-shader-tool from these same lists), so that a
+// binding number or a block field cannot differ between the two. No GL.
 #pragma once
 
 #include <glm/mat4x4.hpp>
@@ -81,6 +81,22 @@ namespace downpour::render {
   X(mat4, lamp_rings,                                                                         \
     "column l: the lamp map's ring l, as road_water_rings: xy lower-left corner, z 1 / "      \
     "side, w cell (m)")
+
+// Shader storage buffers: X(C++ name, binding, GLSL macro, what it holds). A shader declares its
+// block at the macro: layout(std430, binding = RUNS_BUFFER).
+#define DOWNPOUR_STORAGE_BUFFERS(X)                                                               \
+  X(kRunsBuffer, 0, RUNS_BUFFER,                                                                  \
+    "runs of a layer's tiles, uv x0 y0 x1 y1 (rain.vert: the rain layer's; spray_runs.vert: the " \
+    "spray layer's)")                                                                             \
+  X(kParcelsBuffer, 1, PARCELS_BUFFER, "the spray's parcels (spray_depth.vert)")                  \
+  X(kHazeBuffer, 2, HAZE_BUFFER, "the spray's haze splats (spray_haze.vert)")
+
+namespace storage_buffer {
+#define DOWNPOUR_BUFFER_CONSTANT(name, binding, glsl, what) \
+  inline constexpr unsigned name = binding;
+DOWNPOUR_STORAGE_BUFFERS(DOWNPOUR_BUFFER_CONSTANT)
+#undef DOWNPOUR_BUFFER_CONSTANT
+}  // namespace storage_buffer
 
 inline constexpr unsigned kFrameBlockBinding = 0;
 // The frame's lamps (light_set.hpp's pack_lamps), a second uniform block: per lamp four vec4s,

@@ -153,7 +153,7 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
     runs_uv_.emplace_back(r.x0 * texel.x, r.y0 * texel.y, r.x1 * texel.x, r.y1 * texel.y);
   glNamedBufferSubData(buffer.id(), 0, static_cast<GLsizeiptr>(runs_uv_.size() * sizeof(glm::vec4)),
                        runs_uv_.data());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buffer.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, storage_buffer::kRunsBuffer, buffer.id());
   program_.use();
   glBindVertexArray(vao_.id());
   // The tiles clear of the cabin (all of them but in the driver's views) need no depth test: the

@@ -189,7 +189,7 @@ void SprayPass::upload(Buffer& buffer, const void* data, std::size_t bytes) {
 
 void SprayPass::draw_runs(const std::vector<glm::vec4>& runs) {
   upload(runs_buffer_, runs.data(), runs.size() * sizeof(glm::vec4));
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, runs_buffer_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, storage_buffer::kRunsBuffer, runs_buffer_.id());
   glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(6 * runs.size()));
 }
 
@@ -220,7 +220,7 @@ void SprayPass::depth_maps(const FrameContext& frame, Targets& t) {
   for (const auto* list : {&spray_, &body_})
     for (const SprayBall& b : *list) packed_.emplace_back(b.centre, b.radius);
   upload(parcels_, packed_.data(), packed_.size() * sizeof(glm::vec4));
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, parcels_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, storage_buffer::kParcelsBuffer, parcels_.id());
   depth_program_.use();
   u_depth_projection_.set(frame.camera.projection);
   u_depth_spray_.set(static_cast<int>(spray_.size()));
@@ -252,7 +252,7 @@ void SprayPass::haze_map(const FrameContext& frame, Targets& t) {
     packed_.emplace_back(h.depth, 0.0f, 0.0f, 0.0f);
   }
   upload(haze_, packed_.data(), packed_.size() * sizeof(glm::vec4));
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, haze_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, storage_buffer::kHazeBuffer, haze_.id());
   haze_program_.use();
   u_haze_projection_.set(frame.camera.projection);
   glEnable(GL_BLEND);
@@ -283,7 +283,7 @@ GLuint SprayPass::smooth(Targets& t, const std::vector<glm::vec4>& runs, glm::ve
     u_bilateral_sigma_z_.set(2.0f * std::sqrt(2.0f) * kBodyRadiusM);
   }
   upload(runs_buffer_, runs.data(), runs.size() * sizeof(glm::vec4));
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, runs_buffer_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, storage_buffer::kRunsBuffer, runs_buffer_.id());
   glViewport(0, 0, t.width, t.height);
   // Only where the mask holds the body (llvmpipe rejects the rest before shading).
   apply(RenderState{DepthTest::kNearer, false, Blend::kOff});
@@ -490,7 +490,7 @@ void SprayCompositePass::execute(const FrameContext&, const FrameResources&) {
   if (runs.empty()) return;
   glNamedBufferData(runs_buffer_.id(), static_cast<GLsizeiptr>(runs.size() * sizeof(glm::vec4)),
                     runs.data(), GL_STREAM_DRAW);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, runs_buffer_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, storage_buffer::kRunsBuffer, runs_buffer_.id());
   program_.use();
   glBindVertexArray(vao_.id());
   glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(6 * runs.size()));

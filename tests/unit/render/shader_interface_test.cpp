@@ -1,0 +1,67 @@
+// The generated GLSL side of the renderer's interface (shader_interface.hpp): every texture unit,
+// storage buffer and frame-block field the C++ lists name, at the binding the C++ uses.
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "server/render/shader_interface.hpp"
+#include "server/render/shader_source.hpp"
+
+namespace downpour::render {
+namespace {
+
+TEST(ShaderInterfaceTest, TheGeneratedGlslDeclaresWhatTheCppLists) {
+  const std::string glsl = interface_glsl();
+  int units = 0, buffers = 0, fields = 0;
+#define EXPECT_UNIT(name, unit, type, glsl_name, what)                                          \
+  EXPECT_NE(glsl.find("layout(binding = " + std::to_string(texture_unit::name) + ") uniform " + \
+                      #type + " " + #glsl_name + ";"),                                          \
+            std::string::npos)                                                                  \
+      << #glsl_name;                                                                            \
+  ++units;
+  DOWNPOUR_TEXTURE_UNITS(EXPECT_UNIT)
+#undef EXPECT_UNIT
+#define EXPECT_BUFFER(name, binding, macro, what)                  \
+  EXPECT_NE(glsl.find(std::string("#define ") + #macro + " " +     \
+                      std::to_string(storage_buffer::name) + " "), \
+            std::string::npos)                                     \
+      << #macro;                                                   \
+  ++buffers;
+  DOWNPOUR_STORAGE_BUFFERS(EXPECT_BUFFER)
+#undef EXPECT_BUFFER
+#define EXPECT_FIELD(type, name, what)                                                             \
+  EXPECT_NE(glsl.find(std::string("  ") + #type + " " + #name + ";"), std::string::npos) << #name; \
+  ++fields;
+  DOWNPOUR_FRAME_BLOCK(EXPECT_FIELD)
+#undef EXPECT_FIELD
+  EXPECT_GE(units, 20);
+  EXPECT_EQ(buffers, 3);
+  EXPECT_GE(fields, 18);
+  EXPECT_NE(glsl.find("layout(std140, binding = " + std::to_string(kFrameBlockBinding) +
+                      ") uniform FrameBlock {"),
+            std::string::npos);
+  EXPECT_NE(glsl.find("layout(std140, binding = " + std::to_string(kLampBlockBinding) +
+                      ") uniform LampBlock {"),
+            std::string::npos);
+  EXPECT_NE(glsl.find("vec4 lamp[" + std::to_string(4 * kMaxLamps) + "];"), std::string::npos);
+}
+
+TEST(ShaderInterfaceTest, NoTwoTextureUnitsOrStorageBuffersShareABinding) {
+  bool unit_taken[64] = {};
+#define CHECK_UNIT(name, unit, type, glsl_name, what) \
+  ASSERT_LT(unit, 64);                                \
+  EXPECT_FALSE(unit_taken[unit]) << #glsl_name;       \
+  unit_taken[unit] = true;
+  DOWNPOUR_TEXTURE_UNITS(CHECK_UNIT)
+#undef CHECK_UNIT
+  bool buffer_taken[16] = {};
+#define CHECK_BUFFER(name, binding, macro, what) \
+  ASSERT_LT(binding, 16);                        \
+  EXPECT_FALSE(buffer_taken[binding]) << #macro; \
+  buffer_taken[binding] = true;
+  DOWNPOUR_STORAGE_BUFFERS(CHECK_BUFFER)
+#undef CHECK_BUFFER
+}
+
+}  // namespace
+}  // namespace downpour::render
