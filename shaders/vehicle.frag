@@ -2,7 +2,7 @@
 #include "common.glsl"
 in vec3 v_world;
 in vec3 v_normal;
-in vec2 v_uv;  // x material id (vehicle_geometry.hpp)
+in vec2 v_uv;  // x material id (MATERIAL_*, interface.glsl)
 in vec4 v_fog;
 out vec4 out_colour;
 uniform vec3 u_body_colour;
@@ -26,22 +26,27 @@ void main() {
   float r0 = 0.04, gloss = 1.0;
   vec3 emit = vec3(0.0);
   const vec3 red = vec3(1.0, 0.005, 0.003), amber = vec3(1.0, 0.45, 0.0);
-  if (material == 1) { albedo = vec3(0.02, 0.025, 0.03); r0 = 0.06; }       // glass
-  else if (material == 2) { albedo = vec3(0.02); gloss = 0.1; }              // tyre
-  else if (material == 3) {                                                  // tail and brake
+  if (material == MATERIAL_GLASS) {
+    albedo = vec3(0.02, 0.025, 0.03);
+    r0 = 0.06;
+  } else if (material == MATERIAL_TYRE) {
+    albedo = vec3(0.02);
+    gloss = 0.1;
+  } else if (material == MATERIAL_LAMP) {  // tail and brake
     albedo = vec3(0.3, 0.02, 0.02);
     emit = lens(red, 100.0 * u_lamps.x + 1500.0 * u_lamps.y,
                 0.5 * u_lamps.x + 1.2 * u_lamps.y, 1.5 + 1.5 * u_lamps.y);
-  }
-  else if (material == 4) { albedo = vec3(0.03); gloss = 0.2; }              // trim
-  else if (material == 5 || material == 8) {                                 // headlamp, street lamp
+  } else if (material == MATERIAL_TRIM) {
+    albedo = vec3(0.03);
+    gloss = 0.2;
+  } else if (material == MATERIAL_HEADLAMP || material == MATERIAL_STREET_LAMP) {
     albedo = vec3(0.45);
-    emit = lens(vec3(1.0, 0.96, 0.88), material == 8 ? 5e4 : 2e5 * u_head, 1.5, 1e4) *
-           step(0.5, u_head);
-  }
-  else if (material == 6 || material == 7) {                                // indicators
+    float intensity = material == MATERIAL_STREET_LAMP ? 5e4 : 2e5 * u_head;
+    emit = lens(vec3(1.0, 0.96, 0.88), intensity, 1.5, 1e4) * step(0.5, u_head);
+  } else if (material == MATERIAL_INDICATOR_LEFT || material == MATERIAL_INDICATOR_RIGHT) {
     albedo = vec3(0.35, 0.2, 0.02);
-    emit = lens(amber, 5000.0, 1.0, 3.0) * (material == 6 ? u_lamps.z : u_lamps.w);
+    float on = material == MATERIAL_INDICATOR_LEFT ? u_lamps.z : u_lamps.w;
+    emit = lens(amber, 5000.0, 1.0, 3.0) * on;
   }
   // The lamps' light on the ground as what falls on this face: whole on a roof, a tenth on a side
   // (the street lights shine down; the cars' own beams are the ego car's, per pixel).

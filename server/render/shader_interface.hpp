@@ -1,7 +1,7 @@
-// The interface between the C++ renderer and its shaders, defined once: texture units, storage
-// buffers' bindings, the per-frame uniform block (std140) and its binding. The build writes the
-// GLSL side of it (interface.glsl, made by downpour-shader-tool from these same lists), so that a
-// binding number or a block field cannot differ between the two. No GL.
+// The interface between the C++ renderer and its shaders, defined once: texture units, material
+// ids, storage buffers' bindings, the per-frame uniform block (std140) and its binding. The build
+// writes the GLSL side of it (interface.glsl, made by downpour-shader-tool from these same lists),
+// so that a binding number or a block field cannot differ between the two. No GL.
 #pragma once
 
 #include <glm/mat4x4.hpp>
@@ -81,6 +81,25 @@ namespace downpour::render {
   X(mat4, lamp_rings,                                                                         \
     "column l: the lamp map's ring l, as road_water_rings: xy lower-left corner, z 1 / "      \
     "side, w cell (m)")
+
+// Material ids, carried in a mesh vertex's uv.x (vehicle_geometry.hpp, scene_geometry.cpp) and
+// read by vehicle.frag and cockpit.frag: X(C++ name, id, GLSL constant, what).
+#define DOWNPOUR_MATERIALS(X)                                             \
+  X(kBody, 0, MATERIAL_BODY, "paint, or the cabin's dashboard")           \
+  X(kGlass, 1, MATERIAL_GLASS, "windows")                                 \
+  X(kTyre, 2, MATERIAL_TYRE, "tyres")                                     \
+  X(kLamp, 3, MATERIAL_LAMP, "tail and brake lamps")                      \
+  X(kTrim, 4, MATERIAL_TRIM, "black trim, or the cabin's other plastics") \
+  X(kHeadlamp, 5, MATERIAL_HEADLAMP, "headlamps")                         \
+  X(kIndicatorLeft, 6, MATERIAL_INDICATOR_LEFT, "the left indicators")    \
+  X(kIndicatorRight, 7, MATERIAL_INDICATOR_RIGHT, "the right indicators") \
+  X(kStreetLamp, 8, MATERIAL_STREET_LAMP, "a street light's lens (street_light_pass.hpp)")
+
+namespace material {
+#define DOWNPOUR_MATERIAL_CONSTANT(name, id, glsl, what) inline constexpr float name = id;
+DOWNPOUR_MATERIALS(DOWNPOUR_MATERIAL_CONSTANT)
+#undef DOWNPOUR_MATERIAL_CONSTANT
+}  // namespace material
 
 // Shader storage buffers: X(C++ name, binding, GLSL macro, what it holds). A shader declares its
 // block at the macro: layout(std430, binding = RUNS_BUFFER).

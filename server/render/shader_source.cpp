@@ -62,7 +62,7 @@ ShaderSource resolve_shader(const std::string& file) {
 std::string interface_glsl() {
   std::string s =
       "// Generated from server/render/shader_interface.hpp: the per-frame uniform block, the\n"
-      "// texture units and the storage buffers' bindings. Do not edit.\n";
+      "// texture units, the material ids and the storage buffers' bindings. Do not edit.\n";
   s +=
       "layout(std140, binding = " + std::to_string(kFrameBlockBinding) + ") uniform FrameBlock {\n";
 #define DOWNPOUR_GLSL_FIELD(type, name, what) \
@@ -79,6 +79,10 @@ std::string interface_glsl() {
        #glsl + ";  // " + what + "\n";
   DOWNPOUR_TEXTURE_UNITS(DOWNPOUR_GLSL_UNIT)
 #undef DOWNPOUR_GLSL_UNIT
+#define DOWNPOUR_GLSL_MATERIAL(name, id, glsl, what) \
+  s += std::string("const int ") + #glsl + " = " + std::to_string(id) + ";  // " + what + "\n";
+  DOWNPOUR_MATERIALS(DOWNPOUR_GLSL_MATERIAL)
+#undef DOWNPOUR_GLSL_MATERIAL
 #define DOWNPOUR_GLSL_BUFFER(name, binding, glsl, what) \
   s += std::string("#define ") + #glsl + " " + std::to_string(binding) + "  // " + what + "\n";
   DOWNPOUR_STORAGE_BUFFERS(DOWNPOUR_GLSL_BUFFER)

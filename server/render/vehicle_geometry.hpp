@@ -5,6 +5,7 @@
 #include <glm/vec3.hpp>
 
 #include "server/render/mesh_data.hpp"
+#include "server/render/shader_interface.hpp"
 #include "server/sim/windshield.hpp"
 
 namespace downpour::render {
@@ -18,18 +19,7 @@ struct WindshieldCorners {
 };
 WindshieldCorners windshield_corners(const sim::GlassConfig& glass);
 
-// Material ids carried in uv.x, read by vehicle.frag and cockpit.frag.
-namespace material {
-inline constexpr float kBody = 0.0f;
-inline constexpr float kGlass = 1.0f;
-inline constexpr float kTyre = 2.0f;
-inline constexpr float kLamp = 3.0f;
-inline constexpr float kTrim = 4.0f;
-inline constexpr float kHeadlamp = 5.0f;
-inline constexpr float kIndicatorLeft = 6.0f;
-inline constexpr float kIndicatorRight = 7.0f;
-inline constexpr float kStreetLamp = 8.0f;  // a street light's lens (street_light_pass.hpp)
-}  // namespace material
+// (Material ids, carried in uv.x: shader_interface.hpp's material::.)
 
 // A passenger car about 4.6 x 1.8 x 1.47 m: the hull (the lower body, whose hood shows from the
 // driver's seat) and the rest (cabin, roof, wheels, lamps).

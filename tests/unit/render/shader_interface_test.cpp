@@ -1,5 +1,6 @@
 // The generated GLSL side of the renderer's interface (shader_interface.hpp): every texture unit,
-// storage buffer and frame-block field the C++ lists name, at the binding the C++ uses.
+// material id, storage buffer and frame-block field the C++ lists name, with the value the C++
+// uses.
 #include <string>
 
 #include <gtest/gtest.h>
@@ -12,7 +13,7 @@ namespace {
 
 TEST(ShaderInterfaceTest, TheGeneratedGlslDeclaresWhatTheCppLists) {
   const std::string glsl = interface_glsl();
-  int units = 0, buffers = 0, fields = 0;
+  int units = 0, buffers = 0, fields = 0, materials = 0;
 #define EXPECT_UNIT(name, unit, type, glsl_name, what)                                          \
   EXPECT_NE(glsl.find("layout(binding = " + std::to_string(texture_unit::name) + ") uniform " + \
                       #type + " " + #glsl_name + ";"),                                          \
@@ -29,6 +30,14 @@ TEST(ShaderInterfaceTest, TheGeneratedGlslDeclaresWhatTheCppLists) {
   ++buffers;
   DOWNPOUR_STORAGE_BUFFERS(EXPECT_BUFFER)
 #undef EXPECT_BUFFER
+#define EXPECT_MATERIAL(name, id, constant, what)                              \
+  EXPECT_NE(glsl.find(std::string("const int ") + #constant + " = " +          \
+                      std::to_string(static_cast<int>(material::name)) + ";"), \
+            std::string::npos)                                                 \
+      << #constant;                                                            \
+  ++materials;
+  DOWNPOUR_MATERIALS(EXPECT_MATERIAL)
+#undef EXPECT_MATERIAL
 #define EXPECT_FIELD(type, name, what)                                                             \
   EXPECT_NE(glsl.find(std::string("  ") + #type + " " + #name + ";"), std::string::npos) << #name; \
   ++fields;
@@ -36,6 +45,7 @@ TEST(ShaderInterfaceTest, TheGeneratedGlslDeclaresWhatTheCppLists) {
 #undef EXPECT_FIELD
   EXPECT_GE(units, 20);
   EXPECT_EQ(buffers, 3);
+  EXPECT_EQ(materials, 9);
   EXPECT_GE(fields, 18);
   EXPECT_NE(glsl.find("layout(std140, binding = " + std::to_string(kFrameBlockBinding) +
                       ") uniform FrameBlock {"),
