@@ -601,9 +601,9 @@ struct Renderer::Impl {
     } else {
       const int w = r.view_colour.width, h = r.view_colour.height;
       const bool spray = out == Resource::kSprayLayer;
+      const int k = SprayPass::kScale;
       const glm::ivec2 size =
-          spray ? glm::ivec2(std::max(1, (w + SprayPass::kScale - 1) / SprayPass::kScale),
-                             std::max(1, (h + SprayPass::kScale - 1) / SprayPass::kScale))
+          spray ? glm::ivec2(std::max(1, (w + k - 1) / k), std::max(1, (h + k - 1) / k))
                 : f.glass.layer_size(w, h);
       Transient& t = transient(out, size.x, size.y);
       TargetTexture& texture = spray ? r.spray_layer : r.glass_layer;

@@ -1,7 +1,5 @@
 #include "server/render/passes/glass_water_mask_pass.hpp"
 
-#include <algorithm>
-
 #include "server/render/passes/glass_water_pass.hpp"
 
 namespace downpour::render {
@@ -19,7 +17,7 @@ bool GlassWaterMaskPass::wanted(const FrameContext& frame) const {
 }
 
 void GlassWaterMaskPass::execute(const FrameContext& frame, const FrameResources&) {
-  const Mask& m = optics_.pair(std::clamp(frame.glass.layer_scale(), 1, 4)) ? pair_ : footprint_;
+  const Mask& m = optics_.pair(frame.glass.layer_scale()) ? pair_ : footprint_;
   m.program->use();
   m.grid.set(frame.water());
   m.quad.draw(frame);

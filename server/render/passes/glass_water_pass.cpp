@@ -48,7 +48,7 @@ int GlassWaterPass::samples(int layer_scale) const {
 }
 
 void GlassWaterPass::execute(const FrameContext& frame, const FrameResources& resources) {
-  const int scale = std::clamp(frame.glass.layer_scale(), 1, 4);
+  const int scale = frame.glass.layer_scale();  // 1 to 4
   const int samples = this->samples(scale);
   const Optics& o = scale == 1 ? sharp_ : pair(scale) ? pair_ : blurred_;
   o.program->use();
