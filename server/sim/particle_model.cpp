@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
 #include "server/sim/drop_physics.hpp"
@@ -26,89 +28,96 @@ double ParticleModel::mass() const {
   return m;
 }
 
-// Pairwise repulsion through a spatial hash: grid cells of one particle diameter, hashed into a
-// table about twice the particle count, so the cost follows the particles, not the glass. The
-// iterations work on float copies of the positions sorted by bucket (a counting sort, so the order
-// and the result are deterministic): a bucket's particles are one contiguous run.
+// Pairwise repulsion over a grid of cells one particle diameter wide. Once per step the particles
+// are sorted by cell, row by row (a radix sort on the cell's key, so the order and the result are
+// deterministic), and the iterations work on float copies of the positions in that order. A pair
+// is then tested once, from its earlier particle: the rest of that particle's row up to the next
+// cell, and the three cells below it in the next row. The start of those three in the sorted list
+// only moves forward as the particle does, so one cursor finds it.
 void ParticleModel::repel() {
   const WaterConfig& w = config_;
   const float touch = static_cast<float>(2.0 * w.particle_radius_mm);
   const float push = static_cast<float>(0.5 + w.penalty);  // half the overlap, plus the penalty
   const std::uint32_t count = static_cast<std::uint32_t>(particles_.size());
   if (count < 2) return;
-  std::uint32_t buckets = 64;
-  while (buckets < 2 * count) buckets *= 2;
-  const std::uint32_t mask = buckets - 1;
   const float inv_touch = 1.0f / touch;
-  auto bucket_of = [&](int cu, int cv) {
-    return (static_cast<std::uint32_t>(cu) * 73856093u ^
-            static_cast<std::uint32_t>(cv) * 19349663u) &
-           mask;
-  };
-  hash_ids_.resize(count);
-  hash_pos_.resize(count);
-  hash_cell_.resize(count);
-  // The particles sorted by bucket once per step: within a step they move by a fraction of their
-  // size, and a pair that slips out of each other's 3 x 3 cells is found at the next step.
-  hash_start_.assign(buckets + 1, 0u);
+  sort_cell_.resize(count);
+  glm::ivec2 lo(std::numeric_limits<int>::max()), hi(std::numeric_limits<int>::min());
   for (std::uint32_t i = 0; i < count; ++i) {
     const glm::dvec2 p = particles_[i].pos;
     const glm::ivec2 c(static_cast<int>(std::floor(static_cast<float>(p.x) * inv_touch)),
                        static_cast<int>(std::floor(static_cast<float>(p.y) * inv_touch)));
-    hash_cell_[i] = c;
-    ++hash_start_[bucket_of(c.x, c.y) + 1];
+    sort_cell_[i] = c;
+    lo = glm::min(lo, c);
+    hi = glm::max(hi, c);
   }
-  for (std::uint32_t b = 1; b <= buckets; ++b) hash_start_[b] += hash_start_[b - 1];
-  hash_fill_.assign(hash_start_.begin(), hash_start_.end() - 1);
+  // Key = row * width + column, with a free column on each side so that a cell's neighbours
+  // across never wrap into the next row.
+  const std::uint64_t width = static_cast<std::uint64_t>(hi.x - lo.x) + 3;
+  sort_key_.resize(count);
+  sort_ids_.resize(count);
+  std::uint64_t max_key = 0;
   for (std::uint32_t i = 0; i < count; ++i) {
-    const std::uint32_t slot = hash_fill_[bucket_of(hash_cell_[i].x, hash_cell_[i].y)]++;
-    hash_ids_[slot] = i;
-    hash_pos_[slot] = glm::vec2(particles_[i].pos);
+    const glm::ivec2 c = sort_cell_[i] - lo;
+    sort_key_[i] = static_cast<std::uint64_t>(c.y) * width + static_cast<std::uint64_t>(c.x) + 1;
+    max_key = std::max(max_key, sort_key_[i]);
+    sort_ids_[i] = i;
   }
-  // The buckets of each particle's 3 x 3 cells, without repeats (hash collisions).
-  hash_neighbours_.resize(static_cast<std::size_t>(count) * 9);
-  hash_neighbour_count_.resize(count);
-  for (std::uint32_t a = 0; a < count; ++a) {
-    const glm::ivec2 c = hash_cell_[hash_ids_[a]];
-    std::uint32_t* seen = &hash_neighbours_[static_cast<std::size_t>(a) * 9];
-    int seen_count = 0;
-    for (int dv = -1; dv <= 1; ++dv) {
-      for (int du = -1; du <= 1; ++du) {
-        const std::uint32_t b = bucket_of(c.x + du, c.y + dv);
-        if (std::find(seen, seen + seen_count, b) == seen + seen_count) seen[seen_count++] = b;
-      }
+  // LSD radix sort of the ids by key, 11 bits a pass (two passes for any windshield).
+  constexpr int kDigitBits = 11;
+  constexpr std::uint32_t kDigits = 1u << kDigitBits;
+  sort_scratch_.resize(count);
+  sort_counts_.resize(kDigits + 1);
+  for (int shift = 0; shift < 64 && (max_key >> shift) != 0; shift += kDigitBits) {
+    std::fill(sort_counts_.begin(), sort_counts_.end(), 0u);
+    for (std::uint32_t i = 0; i < count; ++i)
+      ++sort_counts_[((sort_key_[sort_ids_[i]] >> shift) & (kDigits - 1)) + 1];
+    for (std::uint32_t d = 1; d <= kDigits; ++d) sort_counts_[d] += sort_counts_[d - 1];
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const std::uint32_t id = sort_ids_[i];
+      sort_scratch_[sort_counts_[(sort_key_[id] >> shift) & (kDigits - 1)]++] = id;
     }
-    hash_neighbour_count_[a] = static_cast<std::uint8_t>(seen_count);
+    sort_ids_.swap(sort_scratch_);
+  }
+  sorted_key_.resize(count);
+  sorted_pos_.resize(count);
+  for (std::uint32_t a = 0; a < count; ++a) {
+    sorted_key_[a] = sort_key_[sort_ids_[a]];
+    sorted_pos_[a] = glm::vec2(particles_[sort_ids_[a]].pos);
   }
 
+  const float touch2 = touch * touch;
+  auto part = [&](std::uint32_t a, std::uint32_t k) {
+    const glm::vec2 delta = sorted_pos_[k] - sorted_pos_[a];
+    const float dist2 = glm::dot(delta, delta);
+    if (dist2 >= touch2) return false;
+    const float dist = std::sqrt(dist2);
+    // Coincident particles part along a direction that depends only on their ids.
+    const float angle =
+        static_cast<float>(sort_ids_[a]) * 2.399f + static_cast<float>(sort_ids_[k]);
+    const glm::vec2 dir = dist > 1e-6f ? delta / dist : glm::vec2(std::cos(angle), std::sin(angle));
+    const glm::vec2 move = (push * (touch - dist)) * dir;
+    sorted_pos_[a] -= move;
+    sorted_pos_[k] += move;
+    return true;
+  };
   for (int iteration = 0; iteration < kRepulsionIterations; ++iteration) {
     bool overlapped = false;
+    std::uint32_t below = 0;  // the first particle at or after the cell below-left of a's
     for (std::uint32_t a = 0; a < count; ++a) {
-      const std::uint32_t* neighbours = &hash_neighbours_[static_cast<std::size_t>(a) * 9];
-      for (int n = 0; n < hash_neighbour_count_[a]; ++n) {
-        const std::uint32_t b = neighbours[n];
-        for (std::uint32_t k = std::max(hash_start_[b], a + 1); k < hash_start_[b + 1]; ++k) {
-          const glm::vec2 delta = hash_pos_[k] - hash_pos_[a];
-          const float dist2 = glm::dot(delta, delta);
-          if (dist2 >= touch * touch) continue;
-          const float dist = std::sqrt(dist2);
-          // Coincident particles part along a direction that depends only on their ids.
-          const float angle =
-              static_cast<float>(hash_ids_[a]) * 2.399f + static_cast<float>(hash_ids_[k]);
-          const glm::vec2 dir =
-              dist > 1e-6f ? delta / dist : glm::vec2(std::cos(angle), std::sin(angle));
-          const glm::vec2 move = (push * (touch - dist)) * dir;
-          hash_pos_[a] -= move;
-          hash_pos_[k] += move;
-          overlapped = true;
-        }
-      }
+      const std::uint64_t key = sorted_key_[a];
+      for (std::uint32_t k = a + 1; k < count && sorted_key_[k] <= key + 1; ++k)
+        overlapped |= part(a, k);
+      const std::uint64_t first = key + width - 1, last = key + width + 1;
+      while (below < count && sorted_key_[below] < first) ++below;
+      for (std::uint32_t k = below; k < count && sorted_key_[k] <= last; ++k)
+        overlapped |= part(a, k);
     }
     if (!overlapped) break;
   }
   for (std::uint32_t a = 0; a < count; ++a) {
-    glm::dvec2& p = particles_[hash_ids_[a]].pos;
-    const glm::dvec2 moved(hash_pos_[a]);
+    glm::dvec2& p = particles_[sort_ids_[a]].pos;
+    const glm::dvec2 moved(sorted_pos_[a]);
     if (moved != glm::dvec2(glm::vec2(p))) p = moved;  // untouched ones keep their precision
   }
 }

@@ -39,13 +39,13 @@ class ParticleModel {
   WaterConfig config_;
   std::vector<Particle> particles_;
   double particle_mass_ = 0.0;
-  // Neighbour hash: bucket start offsets and the ids sorted by bucket.
-  std::vector<std::uint32_t> hash_start_, hash_fill_;
-  std::vector<std::uint32_t> hash_ids_;             // particle index, in bucket order
-  std::vector<glm::vec2> hash_pos_;                 // its position, in bucket order
-  std::vector<glm::ivec2> hash_cell_;               // grid cell, in particle order
-  std::vector<std::uint32_t> hash_neighbours_;      // 9 buckets a particle, in bucket order
-  std::vector<std::uint8_t> hash_neighbour_count_;  // how many of them are distinct
+  // Scratch for repel: cells and keys in particle order, ids sorted by key, and the sorted
+  // particles' keys and float positions.
+  std::vector<glm::ivec2> sort_cell_;
+  std::vector<std::uint64_t> sort_key_;
+  std::vector<std::uint32_t> sort_ids_, sort_scratch_, sort_counts_;
+  std::vector<std::uint64_t> sorted_key_;
+  std::vector<glm::vec2> sorted_pos_;
 };
 
 }  // namespace downpour::sim
