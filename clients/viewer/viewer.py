@@ -44,6 +44,7 @@ import grpc  # noqa: E402
 from downpour_client import (  # noqa: E402
     DownpourClient, add_security_arguments, enum_name, security_options, view_spec)
 from downpour.v1 import downpour_pb2 as pb  # noqa: E402
+from downpour_client.weather_fields import FIELDS as WEATHER_DEFINITION  # noqa: E402
 
 MIN_RATE_SPAN_S = 0.5
 MAX_BODY_BYTES = 64 * 1024  # a POST's JSON body
@@ -583,12 +584,9 @@ class Car:
         return state
 
 
-WEATHER_RANGES = {
-    "rain_rate_mm_h": (0.0, 500.0), "wind_speed_mps": (0.0, 100.0),
-    "wind_direction_deg": (-360.0, 360.0), "fog_density": (0.0, 1.0), "cloudiness": (0.0, 1.0),
-    "sun_altitude_deg": (-90.0, 90.0), "sun_azimuth_deg": (-360.0, 360.0),
-    "rain_angle_deg": (-70.0, 70.0),
-}
+# The page may set every weather field but the streak count, within the contract's ranges.
+WEATHER_RANGES = {field["name"]: (field["min"], field["max"])
+                  for field in WEATHER_DEFINITION if not field["integer"]}
 DEFAULT_WEATHER = {"rain_rate_mm_h": 20.0, "wind_speed_mps": 3.0, "wind_direction_deg": 60.0,
                    "fog_density": 0.05, "cloudiness": 0.8, "sun_altitude_deg": 30.0,
                    "sun_azimuth_deg": 200.0, "rain_angle_deg": 0.0}

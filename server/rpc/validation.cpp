@@ -134,19 +134,26 @@ grpc::Status to_wipers(const v1::WiperState& in, const std::string& field, sim::
   return grpc::Status::OK;
 }
 
+// Each field as sim/weather.hpp defines it, found in the message by its name (a unit test checks
+// that the two lists agree).
 grpc::Status to_weather(const v1::Weather& in, const std::string& f, sim::Weather* out) {
-  DP_RETURN_IF_ERROR(in_range(in.rain_rate_mm_h(), 0.0, 500.0, f + ".rain_rate_mm_h"));
-  DP_RETURN_IF_ERROR(in_range(in.wind_speed_mps(), 0.0, 100.0, f + ".wind_speed_mps"));
-  DP_RETURN_IF_ERROR(in_range(in.wind_direction_deg(), -360.0, 360.0, f + ".wind_direction_deg"));
-  DP_RETURN_IF_ERROR(in_range(in.fog_density(), 0.0, 1.0, f + ".fog_density"));
-  DP_RETURN_IF_ERROR(in_range(in.cloudiness(), 0.0, 1.0, f + ".cloudiness"));
-  DP_RETURN_IF_ERROR(in_range(in.sun_altitude_deg(), -90.0, 90.0, f + ".sun_altitude_deg"));
-  DP_RETURN_IF_ERROR(in_range(in.sun_azimuth_deg(), -360.0, 360.0, f + ".sun_azimuth_deg"));
-  DP_RETURN_IF_ERROR(in_range(in.rain_streak_count(), 0.0, 80000.0, f + ".rain_streak_count"));
-  DP_RETURN_IF_ERROR(in_range(in.rain_angle_deg(), -70.0, 70.0, f + ".rain_angle_deg"));
-  *out = {in.rain_rate_mm_h(),  in.wind_speed_mps(),    in.wind_direction_deg(),
-          in.fog_density(),     in.cloudiness(),        in.sun_altitude_deg(),
-          in.sun_azimuth_deg(), in.rain_streak_count(), in.rain_angle_deg()};
+  const google::protobuf::Descriptor* message = in.GetDescriptor();
+  const google::protobuf::Reflection* reflection = in.GetReflection();
+  sim::Weather w;
+  for (const sim::WeatherField& field : sim::kWeatherFields) {
+    const google::protobuf::FieldDescriptor* wire =
+        message->FindFieldByName(std::string(field.name));
+    if (wire == nullptr) {
+      return grpc::Status(grpc::StatusCode::INTERNAL,
+                          "weather field " + std::string(field.name) + " is not in the contract");
+    }
+    const double v = wire->cpp_type() == google::protobuf::FieldDescriptor::CPPTYPE_UINT32
+                         ? reflection->GetUInt32(in, wire)
+                         : reflection->GetDouble(in, wire);
+    DP_RETURN_IF_ERROR(in_range(v, field.min, field.max, f + "." + std::string(field.name)));
+    field.set(w, v);
+  }
+  *out = w;
   return grpc::Status::OK;
 }
 

@@ -16,8 +16,6 @@ namespace {
 
 using nlohmann::json;
 
-double lerp(double a, double b, double u) { return a + (b - a) * u; }
-
 double lerp_angle_deg(double a, double b, double u) {
   const double d = std::remainder(b - a, 360.0);  // in [-180, 180]
   return a + d * u;
@@ -35,16 +33,7 @@ VehicleState mix(const VehicleState& a, const VehicleState& b, double u) {
 
 Weather mix(const Weather& a, const Weather& b, double u) {
   Weather w;
-  w.rain_rate_mm_h = lerp(a.rain_rate_mm_h, b.rain_rate_mm_h, u);
-  w.wind_speed_mps = lerp(a.wind_speed_mps, b.wind_speed_mps, u);
-  w.wind_direction_deg = lerp_angle_deg(a.wind_direction_deg, b.wind_direction_deg, u);
-  w.fog_density = lerp(a.fog_density, b.fog_density, u);
-  w.cloudiness = lerp(a.cloudiness, b.cloudiness, u);
-  w.sun_altitude_deg = lerp(a.sun_altitude_deg, b.sun_altitude_deg, u);
-  w.sun_azimuth_deg = lerp_angle_deg(a.sun_azimuth_deg, b.sun_azimuth_deg, u);
-  w.rain_streak_count =
-      static_cast<std::uint32_t>(std::lround(lerp(a.rain_streak_count, b.rain_streak_count, u)));
-  w.rain_angle_deg = lerp(a.rain_angle_deg, b.rain_angle_deg, u);
+  for (const WeatherField& f : kWeatherFields) f.set(w, interpolate(f, f.get(a), f.get(b), u));
   return w;
 }
 
@@ -266,21 +255,48 @@ Scenario Scenario::from_json(const std::string& source) {
     if (const json* jw = object(jk, "weather", where)) {
       const std::string ww = where + ".weather";
       Weather w;
-      w.rain_rate_mm_h = number(*jw, "rain_rate_mm_h", ww, w.rain_rate_mm_h);
-      w.wind_speed_mps = number(*jw, "wind_speed_mps", ww, w.wind_speed_mps);
-      w.wind_direction_deg = number(*jw, "wind_direction_deg", ww, w.wind_direction_deg);
-      w.fog_density = number(*jw, "fog_density", ww, w.fog_density);
-      w.cloudiness = number(*jw, "cloudiness", ww, w.cloudiness);
-      w.sun_altitude_deg = number(*jw, "sun_altitude_deg", ww, w.sun_altitude_deg);
-      w.sun_azimuth_deg = number(*jw, "sun_azimuth_deg", ww, w.sun_azimuth_deg);
-      w.rain_streak_count = static_cast<std::uint32_t>(
-          integer(*jw, "rain_streak_count", ww, 0, 0, std::numeric_limits<std::uint32_t>::max()));
-      w.rain_angle_deg = number(*jw, "rain_angle_deg", ww, w.rain_angle_deg);
+      for (const WeatherField& f : kWeatherFields) {
+        const std::string name(f.name);
+        f.set(w, f.integer
+                     ? static_cast<double>(integer(
+                           *jw, name.c_str(), ww, static_cast<std::int64_t>(f.fallback),
+                           static_cast<std::int64_t>(f.min), static_cast<std::int64_t>(f.max)))
+                     : number(*jw, name.c_str(), ww, f.fallback));
+      }
       k.weather = w;
     }
     s.keyframes.push_back(std::move(k));
   }
   return s;
+}
+
+std::string Scenario::samples_json(double step_s) const {
+  json samples = json::array();
+  auto arr = [](glm::dvec3 x) { return json::array({x.x, x.y, x.z}); };
+  const int count = static_cast<int>(std::floor(duration_s / step_s + 1e-9));
+  for (int i = 0; i <= count; ++i) {
+    const double t = i * step_s;
+    const Update u = at(t);
+    json j;
+    j["t"] = t;
+    if (u.vehicle) {
+      const Rotation& r = u.vehicle->rotation;
+      j["vehicle"] = {{"position_m", arr(u.vehicle->position_m)},
+                      {"rotation_deg", json::array({r.yaw_deg, r.pitch_deg, r.roll_deg})},
+                      {"velocity_mps", arr(u.vehicle->velocity_mps)}};
+    }
+    if (u.wipers) {
+      j["wipers"] = {{"mode", wiper_mode_name(u.wipers->mode)},
+                     {"interval_s", u.wipers->interval_s},
+                     {"blade_angle_deg", u.wipers->blade_angle_deg}};
+    }
+    if (u.weather) {
+      json& jw = j["weather"];
+      for (const WeatherField& f : kWeatherFields) jw[std::string(f.name)] = f.get(*u.weather);
+    }
+    samples.push_back(std::move(j));
+  }
+  return samples.dump() + "\n";
 }
 
 std::string Scenario::to_json() const {
@@ -321,15 +337,14 @@ std::string Scenario::to_json() const {
     }
     if (k.weather) {
       const Weather& w = *k.weather;
-      jk["weather"] = {{"rain_rate_mm_h", w.rain_rate_mm_h},
-                       {"wind_speed_mps", w.wind_speed_mps},
-                       {"wind_direction_deg", w.wind_direction_deg},
-                       {"fog_density", w.fog_density},
-                       {"cloudiness", w.cloudiness},
-                       {"sun_altitude_deg", w.sun_altitude_deg},
-                       {"sun_azimuth_deg", w.sun_azimuth_deg},
-                       {"rain_streak_count", w.rain_streak_count},
-                       {"rain_angle_deg", w.rain_angle_deg}};
+      json& jw = jk["weather"];
+      for (const WeatherField& f : kWeatherFields) {
+        if (f.integer) {
+          jw[std::string(f.name)] = static_cast<std::int64_t>(f.get(w));
+        } else {
+          jw[std::string(f.name)] = f.get(w);
+        }
+      }
     }
     root["keyframes"].push_back(jk);
   }

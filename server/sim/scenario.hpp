@@ -33,6 +33,9 @@ struct Scenario {
 
   static Scenario from_json(const std::string& text);  // throws std::runtime_error naming the field
   std::string to_json() const;
+  // at(t) every step_s from 0 to duration_s, as a JSON array of the channels each sample has:
+  // what the test of the C++ and Python readers compares.
+  std::string samples_json(double step_s) const;
 };
 
 // The standard scenes, defined once here and used by the benchmarks and the clients.

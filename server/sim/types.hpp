@@ -11,6 +11,8 @@
 
 #include <glm/vec3.hpp>
 
+#include "server/sim/weather.hpp"
+
 namespace downpour::sim {
 
 // Yaw / pitch / roll in degrees: yaw about world z (counter-clockwise from +x), then pitch about
@@ -45,18 +47,6 @@ struct WiperState {
   WiperMode mode = WiperMode::kOff;
   double interval_s = 4.0;
   std::vector<double> blade_angle_deg;  // kManual: one per blade, from park
-};
-
-struct Weather {
-  double rain_rate_mm_h = 0.0;
-  double wind_speed_mps = 0.0;
-  double wind_direction_deg = 0.0;
-  double fog_density = 0.0;
-  double cloudiness = 0.2;
-  double sun_altitude_deg = 40.0;
-  double sun_azimuth_deg = 135.0;
-  std::uint32_t rain_streak_count = 0;
-  double rain_angle_deg = 0.0;
 };
 
 // What a traffic vehicle is: its shape and where its lamps sit (vehicle_class.hpp).

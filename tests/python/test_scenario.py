@@ -69,13 +69,14 @@ class InterpolationTest(unittest.TestCase):
         self.assertAlmostEqual(weather.fog_density, 0.3)
         self.assertAlmostEqual(weather.sun_altitude_deg, 30.0)
         self.assertEqual(weather.rain_streak_count, 125)  # 100 + 101 * 0.25, rounded
-        self.assertEqual(weather.wind_speed_mps, 0.0)     # left out of the file: 0
+        self.assertEqual(weather.wind_speed_mps, 0.0)     # left out of the file: its default, 0
 
     def test_yaw_takes_the_shortest_arc(self):
-        # 170 -> -170 goes through 180 (20 degrees), not through 0 (340 degrees).
+        # 170 -> -170 goes through 180 (20 degrees), not through 0 (340 degrees). As the server's
+        # reader, the result is not wrapped: 185 is the direction -175.
         self.assertAlmostEqual(self.scenario.at(2.5).vehicle.rotation.yaw_deg, 180.0)
         self.assertAlmostEqual(self.scenario.at(1.25).vehicle.rotation.yaw_deg, 175.0)
-        self.assertAlmostEqual(self.scenario.at(3.75).vehicle.rotation.yaw_deg, -175.0)
+        self.assertAlmostEqual(self.scenario.at(3.75).vehicle.rotation.yaw_deg, 185.0)
 
     def test_wipers_hold_until_the_next_keyframe(self):
         self.assertEqual(self.scenario.at(4.99).wipers.mode, pb.WIPER_LOW)
@@ -85,7 +86,7 @@ class InterpolationTest(unittest.TestCase):
         manual = self.scenario.at(9.0).wipers
         self.assertEqual(manual.mode, pb.WIPER_MANUAL)
         self.assertEqual(list(manual.blade_angle_deg), [30.0, 40.0])
-        self.assertEqual(manual.interval_s, 0.0)
+        self.assertEqual(manual.interval_s, 4.0)  # left out: 4 s, as the server reads it
 
     def test_hold_before_first_and_after_last(self):
         data = scenario_data()

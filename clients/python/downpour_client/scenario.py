@@ -1,10 +1,12 @@
 """Scenario files: a timeline of keyframes, interpolated into Update messages.
 
 Each keyframe may carry any of three channels: vehicle, wipers, weather. A channel is interpolated
-between the neighbouring keyframes that carry it: positions, velocities and weather linearly,
-rotations along the shortest arc, wipers held from the last keyframe at or before t. Before a
-channel's first keyframe its first value holds, after its last keyframe its last value. Fields
-left out inside a channel are 0, as in the proto.
+between the neighbouring keyframes that carry it: positions and velocities linearly, rotations
+along the shortest arc, each weather field as its definition says (weather_fields.py), wipers held
+from the last keyframe at or before t. Before a channel's first keyframe its first value holds,
+after its last keyframe its last value. A weather field left out takes its definition's default;
+a wiper interval left out is 4 s; other fields left out are 0, as in the proto. The server's own
+reader (server/sim/scenario.cpp) gives the same updates: a test compares them sample by sample.
 """
 
 import bisect
@@ -14,11 +16,10 @@ import math
 from downpour.v1 import downpour_pb2 as pb
 
 from .messages import mode_value, rotation, to_view_spec, vec3, view_value, wiper_mode_value
+from .weather_fields import FIELDS as WEATHER
 
-WEATHER_FIELDS = (
-    "rain_rate_mm_h", "wind_speed_mps", "wind_direction_deg", "fog_density", "cloudiness",
-    "sun_altitude_deg", "sun_azimuth_deg", "rain_streak_count", "rain_angle_deg",
-)
+WEATHER_FIELDS = tuple(field["name"] for field in WEATHER)
+DEFAULT_INTERVAL_S = 4.0
 VEHICLE_FIELDS = ("position_m", "rotation_deg", "velocity_mps")
 WIPER_FIELDS = ("mode", "interval_s", "blade_angle_deg")
 VIEW_FIELDS = ("view", "width", "height", "jpeg_quality", "fov_deg", "focus_distance_m",
@@ -102,11 +103,10 @@ class Scenario:
         if self.has_channel("weather"):
             i, j, f = _segment(self._times["weather"], local)
             a, b = self._values["weather"][i], self._values["weather"][j]
-            for field in WEATHER_FIELDS:
-                value = a[field] + (b[field] - a[field]) * f
-                if field == "rain_streak_count":
-                    value = round(value)
-                setattr(update.weather, field, value)
+            for field in WEATHER:
+                name = field["name"]
+                setattr(update.weather, name,
+                        interpolate(field["interpolation"], a[name], b[name], f))
         return update
 
     def create_request(self, mode="LOCKSTEP"):
@@ -132,18 +132,19 @@ def _lerp3(a, b, f):
     return [x + (y - x) * f for x, y in zip(a, b)]
 
 
-def _wrap180(angle):
-    """The same direction in (-180, 180]."""
-    if -180.0 < angle <= 180.0:
-        return angle
-    wrapped = math.fmod(angle + 180.0, 360.0)
-    if wrapped <= 0.0:
-        wrapped += 360.0
-    return wrapped - 180.0
-
-
 def _lerp_angle(a, b, f):
-    return _wrap180(a + _wrap180(b - a) * f)
+    """The shorter way round from a towards b (the result is not wrapped)."""
+    return a + math.remainder(b - a, 360.0) * f
+
+
+def interpolate(kind, a, b, f):
+    """A weather field between keyframes, as weather_fields.py names its interpolation."""
+    if kind == "angle":
+        return _lerp_angle(a, b, f)
+    value = a + (b - a) * f
+    if kind == "round":
+        return int(math.floor(value + 0.5))  # halves up, as C++'s round for these non-negatives
+    return value
 
 
 def _views(data):
@@ -191,7 +192,8 @@ def _wipers(value, path):
         raise ValueError(f"{path}.blade_angle_deg: must be a list of numbers")
     return {
         "mode": wiper_mode_value(mode, f"{path}.mode"),
-        "interval_s": _number(value, "interval_s", f"{path}.interval_s", default=0.0),
+        "interval_s": _number(value, "interval_s", f"{path}.interval_s",
+                              default=DEFAULT_INTERVAL_S),
         "blade_angle_deg": [_finite(a, f"{path}.blade_angle_deg[{i}]")
                             for i, a in enumerate(angles)],
     }
@@ -199,11 +201,14 @@ def _wipers(value, path):
 
 def _weather(value, path):
     _object(value, path, WEATHER_FIELDS)
-    result = {field: _number(value, field, f"{path}.{field}", default=0.0)
-              for field in WEATHER_FIELDS if field != "rain_streak_count"}
-    result["rain_streak_count"] = _integer(value, "rain_streak_count",
-                                           f"{path}.rain_streak_count", default=0,
-                                           maximum=2**32 - 1)
+    result = {}
+    for field in WEATHER:
+        name = field["name"]
+        if field["integer"]:
+            result[name] = _integer(value, name, f"{path}.{name}", default=int(field["default"]),
+                                    minimum=int(field["min"]), maximum=int(field["max"]))
+        else:
+            result[name] = _number(value, name, f"{path}.{name}", default=field["default"])
     return result
 
 

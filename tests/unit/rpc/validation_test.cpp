@@ -111,6 +111,43 @@ TEST(ValidationTest, RainRateOutOfRange) {
   EXPECT_TRUE(update(ok).ok());
 }
 
+// The weather's one definition (sim/weather.hpp) names every field of the contract's Weather and
+// no other, with its type; the server refuses each field just outside its range, naming it, and
+// takes each at its ends.
+TEST(ValidationTest, TheWeatherDefinitionIsTheContractsAndBoundsEveryField) {
+  const google::protobuf::Descriptor* wire = v1::Weather::descriptor();
+  ASSERT_EQ(static_cast<std::size_t>(wire->field_count()), sim::kWeatherFields.size());
+  for (const sim::WeatherField& f : sim::kWeatherFields) {
+    const std::string name(f.name);
+    const google::protobuf::FieldDescriptor* field = wire->FindFieldByName(name);
+    ASSERT_NE(field, nullptr) << name;
+    EXPECT_EQ(field->cpp_type() == google::protobuf::FieldDescriptor::CPPTYPE_UINT32, f.integer)
+        << name;
+    EXPECT_GE(f.fallback, f.min) << name;
+    EXPECT_LE(f.fallback, f.max) << name;
+    auto with = [&](double v) {
+      v1::Update u;
+      const google::protobuf::Reflection* r = u.mutable_weather()->GetReflection();
+      if (f.integer) {
+        r->SetUInt32(u.mutable_weather(), field, static_cast<std::uint32_t>(v));
+      } else {
+        r->SetDouble(u.mutable_weather(), field, v);
+      }
+      return u;
+    };
+    for (double end : {f.min, f.max}) {
+      sim::Update out;
+      ASSERT_TRUE(to_update(with(end), "update", Limits{}, &out).ok()) << name << " " << end;
+      ASSERT_TRUE(out.weather);
+      EXPECT_EQ(f.get(*out.weather), end) << name;
+    }
+    if (!f.integer || f.min > 0.0) {
+      EXPECT_TRUE(invalid_naming(update(with(f.min - 1.0)), "update.weather." + name)) << name;
+    }
+    EXPECT_TRUE(invalid_naming(update(with(f.max + 1.0)), "update.weather." + name)) << name;
+  }
+}
+
 TEST(ValidationTest, ViewSizeOutOfRange) {
   for (int width : {0, 15, 100000}) {
     v1::CreateSessionRequest r;
