@@ -10,7 +10,7 @@ vec3 sky_gradient(vec3 dir) {
   sky = dir.z < 0.0 ? frame.sky_horizon.rgb * (1.0 - 0.15 * clamp(-dir.z * 4.0, 0.0, 1.0)) : sky;
   float sun = max(dot(dir, frame.sun_dir.xyz), 0.0);
   float s2 = sun * sun, s4 = s2 * s2, s8 = s4 * s4;
-  float disc = smoothstep(0.9990, 0.9996, sun) * (1.0 - frame.params.y);
+  float disc = smoothstep(0.9990, 0.9996, sun) * (1.0 - frame.overcast);
   sky += frame.sun_radiance.rgb * (0.25 * s8 * s4 + 0.3 * disc);
   return sky;
 }

@@ -2,7 +2,7 @@
 // A lamp's glow (lamp_glow_pass.hpp): a square around the lamp's point on the screen, at its
 // depth, reaching the halo's radius (or the core's pixel); instance i draws glow i.
 #include "common.glsl"
-uniform vec4 u_glows[3 * 96];  // kMaxGlows: position and halo radius, colour and peak, core
+uniform vec4 u_glows[3 * MAX_GLOWS];  // position and halo radius, colour and peak, core
 uniform vec2 u_pixel;          // one pixel in clip units, x and y
 out vec2 v_offset_px;
 flat out vec4 v_colour;

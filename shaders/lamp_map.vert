@@ -3,7 +3,7 @@
 // ring of the lamp map (lamp_map.hpp); instance i draws lamp i.
 #include "common.glsl"
 uniform int u_ring;
-uniform vec4 u_boxes[64];  // kMaxLamps: x0 y0 x1 y1 (world m)
+uniform vec4 u_boxes[MAX_LAMPS];  // x0 y0 x1 y1 (world m)
 flat out int v_lamp;
 out vec2 v_xy;
 void main() {

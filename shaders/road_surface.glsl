@@ -96,7 +96,7 @@ vec2 lane_mark(float mark, float u, float w, float dash) {
 // rings, the weather's wetness alone. Fine to coarse, done at the first ring that holds xy whole
 // (one lookup, two in a ring's fading band).
 vec2 water_at(vec2 xy) {
-  float wet = frame.params.z;
+  float wet = frame.wetness;
   if (frame.road_water_state.w == 0.0) return vec2(wet * 0.5, wet * wet * 0.15);
   vec2 water = vec2(0.0);
   float rest = 1.0;
@@ -133,7 +133,7 @@ vec3 hash3(ivec2 cell, int cycle) {
 const float kRippleCell = 0.35;
 const float kRippleLife = 0.9;  // s
 vec3 ripple_slope(vec2 xy, float standing_mm) {
-  float chance = clamp(frame.params.w / 25.0, 0.0, 1.0);
+  float chance = clamp(frame.rain_rate_mm_h / 25.0, 0.0, 1.0);
   if (chance <= 0.0) return vec3(0.0);
   // Rings reach a cell's half in a deep puddle, less in a shallow one.
   float reach = kRippleCell * 0.5 * clamp(standing_mm / 4.0, 0.35, 1.0);
@@ -143,7 +143,7 @@ vec3 ripple_slope(vec2 xy, float standing_mm) {
   for (int k = 0; k < 4; ++k) {
     ivec2 cell = base + ivec2(k & 1, k >> 1);
     vec3 h0 = hash3(cell, 0);
-    float phase = frame.params.x / kRippleLife + h0.z;
+    float phase = frame.time_s / kRippleLife + h0.z;
     int cycle = int(floor(phase));
     float age = phase - float(cycle);
     vec3 h = hash3(cell, cycle + 1);
@@ -281,7 +281,7 @@ void main() {
   // hd), a film stands over them (drench: smoother, a blurred mirror), then a puddle (a mirror
   // that ripples under the drops, over the ground seen through it).
   vec2 water = water_at(v_world.xy);
-  float weather_wet = frame.params.z;
+  float weather_wet = frame.wetness;
   // Off the pavement the verge drinks the rain: wet by the weather alone, never standing water.
   float fill = mix(clamp(water.x / frame.road_water_state.x, 0.0, 1.0), weather_wet, verge);
   float film = smoothstep(0.0, 0.3, water.y) * (1.0 - verge);
@@ -339,7 +339,7 @@ void main() {
   // A sheen of the sun on the film, broader than the sun in the mirror.
   float sun = max(dot(r, frame.sun_dir.xyz), 0.0);
   float s2 = sun * sun, s4 = s2 * s2, s8 = s4 * s4;
-  refl += frame.sun_radiance.rgb * (s8 * s8) * 0.6 * film * (1.0 - frame.params.y * 0.7);
+  refl += frame.sun_radiance.rgb * (s8 * s8) * 0.6 * film * (1.0 - frame.overcast * 0.7);
   // The mirror has its own haze (drawn from the mirrored eye along the whole path): only the ground
   // takes the haze of its own distance.
   out_colour = vec4(to_display(apply_fog(colour * (1.0 - k), v_fog) + refl * k), 1.0);

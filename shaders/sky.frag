@@ -8,9 +8,9 @@ void main() {
   vec3 sky = sky_gradient(dir);
   // A cloud deck at about 1.5 km, drifting with the wind; it thickens and greys with overcast.
   if (dir.z > 0.0) {
-    vec2 p = frame.camera_pos.xy + dir.xy * (1500.0 / (dir.z + 0.08)) + frame.wind.xy * frame.params.x * 3.0;
+    vec2 p = frame.camera_pos.xy + dir.xy * (1500.0 / (dir.z + 0.08)) + frame.wind.xy * frame.time_s * 3.0;
     float n = texture(noise_tex, p / 9000.0).r * 0.6 + texture(noise_tex, p / 2300.0).g * 0.4;
-    float overcast = frame.params.y;
+    float overcast = frame.overcast;
     float cover = smoothstep(0.75 - overcast * 0.8, 1.05 - overcast * 0.6, n);
     vec3 cloud_lit = mix(frame.sky_horizon.rgb * 1.15, frame.sky_horizon.rgb * 0.7, overcast * n);
     cloud_lit += frame.sun_radiance.rgb * 0.12;

@@ -17,7 +17,7 @@ void main() {
   grass *= 0.8 + 0.4 * fine;
   vec3 rock = vec3(0.22, 0.21, 0.2) * (0.8 + 0.4 * fine);
   vec3 albedo = mix(grass, rock, smoothstep(0.82, 0.7, n.z));
-  albedo *= mix(1.0, 0.75, frame.params.z);  // wet ground is darker
+  albedo *= mix(1.0, 0.75, frame.wetness);  // wet ground is darker
   vec3 colour = albedo * (diffuse_light(n) + lamp_ground(v_world) * max(n.z, 0.0));
   out_colour = vec4(to_display(apply_fog(colour, v_fog)), 1.0);
 }

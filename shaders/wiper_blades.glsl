@@ -1,6 +1,6 @@
 // The wiper blades in glass space, shared by the glass shaders (wiper_blades.cpp sets them).
-uniform vec4 u_blade_pivot_dir[2];  // xy pivot (mm), zw unit direction from the pivot to the tip
-uniform vec2 u_blade_size[2];       // x length from the pivot (mm), y width of the rubber (mm)
+uniform vec4 u_blade_pivot_dir[WIPER_BLADES];  // xy pivot (mm), zw unit direction to the tip
+uniform vec2 u_blade_size[WIPER_BLADES];  // x length from the pivot (mm), y width of the rubber (mm)
 
 // Coverage in [0, 1] of the blades (x: rubber strips) and of their arms and pivots (y) at glass
 // point p (mm); edges soften over aa mm. The rubber runs over the outer 85 % of the wiped length;

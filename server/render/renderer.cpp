@@ -314,8 +314,10 @@ struct Renderer::Impl {
     b.sky_horizon = glm::vec4(f.atmosphere.sky_horizon, 0.0f);
     b.ambient = glm::vec4(f.atmosphere.ambient, 0.0f);
     b.fog = glm::vec4(f.atmosphere.fog_colour, f.atmosphere.fog_density);
-    b.params = glm::vec4(static_cast<float>(f.scene.sim_time_s), f.atmosphere.overcast,
-                         f.atmosphere.wetness, static_cast<float>(f.scene.weather.rain_rate_mm_h));
+    b.time_s = static_cast<float>(f.scene.sim_time_s);
+    b.overcast = f.atmosphere.overcast;
+    b.wetness = f.atmosphere.wetness;
+    b.rain_rate_mm_h = static_cast<float>(f.scene.weather.rain_rate_mm_h);
     const float wind_dir = glm::radians(static_cast<float>(f.scene.weather.wind_direction_deg));
     b.wind = glm::vec4(std::cos(wind_dir), std::sin(wind_dir), 0.0f, 0.0f) *
              static_cast<float>(f.scene.weather.wind_speed_mps);

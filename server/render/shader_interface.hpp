@@ -1,8 +1,12 @@
 // The interface between the C++ renderer and its shaders, defined once: texture units, material
-// ids, storage buffers' bindings, the per-frame uniform block (std140) and its binding. The build
-// writes the GLSL side of it (interface.glsl, made by downpour-shader-tool from these same lists),
-// so that a binding number or a block field cannot differ between the two. No GL.
+// ids, storage buffers' bindings, the sizes of the shaders' arrays, the per-frame uniform block
+// (std140) and its binding. The build writes the GLSL side of it (interface.glsl, made by
+// downpour-shader-tool from these same lists), so that a binding number, an array's size or a
+// block field cannot differ between the two. No GL.
 #pragma once
+
+#include <cstddef>
+#include <type_traits>
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec4.hpp>
@@ -64,7 +68,10 @@ namespace downpour::render {
   X(vec4, sky_horizon, "rgb")                                                                 \
   X(vec4, ambient, "rgb light from the whole sky on an upward surface")                       \
   X(vec4, fog, "rgb colour, a extinction per metre")                                          \
-  X(vec4, params, "x sim time (s), y overcast, z wetness, w rain rate (mm/h)")                \
+  X(scalar, time_s, "the session's sim time (s)")                                             \
+  X(scalar, overcast, "0 a clear sky to 1 overcast (atmosphere.hpp)")                         \
+  X(scalar, wetness, "the ground's wetness, 0 dry to 1 (atmosphere.hpp)")                     \
+  X(scalar, rain_rate_mm_h, "the weather's rain rate (mm/h)")                                 \
   X(vec4, wind, "xy wind velocity (m/s, world)")                                              \
   X(mat4, mirror_view_proj, "world to the reflection's clip: view_proj times the mirror")     \
   X(vec4, clip_plane, "what is drawn: n.p + w >= 0 (the road reflection's, else everything)") \
@@ -124,7 +131,16 @@ inline constexpr unsigned kFrameBlockBinding = 0;
 //   [2] rgb luminous intensity on the axis (cd), w the cosine of its inner cone (full within),
 //   [3] x 1 for a dipped beam's cut-off, else 0; yz the beam's left, level (unit).
 inline constexpr unsigned kLampBlockBinding = 1;
-inline constexpr int kMaxLamps = 64;
+
+// The sizes of the arrays that shaders declare, as constants in the generated GLSL:
+// X(C++ name, size, GLSL name, what).
+#define DOWNPOUR_ARRAY_SIZES(X)                                                            \
+  X(kMaxLamps, 64, MAX_LAMPS, "lamps a frame knows: the lamp block, the lamp map's boxes") \
+  X(kMaxGlows, 96, MAX_GLOWS, "lamp glows drawn, the strongest (lamp_glow_pass.hpp)")      \
+  X(kWiperBlades, 2, WIPER_BLADES, "wiper blades (wiper_blades.hpp)")
+#define DOWNPOUR_ARRAY_SIZE_CONSTANT(name, size, glsl, what) inline constexpr int name = size;
+DOWNPOUR_ARRAY_SIZES(DOWNPOUR_ARRAY_SIZE_CONSTANT)
+#undef DOWNPOUR_ARRAY_SIZE_CONSTANT
 
 namespace texture_unit {
 #define DOWNPOUR_UNIT_CONSTANT(name, unit, type, glsl, what) inline constexpr unsigned name = unit;
@@ -132,9 +148,12 @@ DOWNPOUR_TEXTURE_UNITS(DOWNPOUR_UNIT_CONSTANT)
 #undef DOWNPOUR_UNIT_CONSTANT
 }  // namespace texture_unit
 
+// A field's C++ type from its name in the list; a scalar is GLSL's float. std140 packs four
+// scalars in a row into one vec4's slot, as the C++ struct does: keep them in fours.
 namespace detail {
 using mat4 = glm::mat4;
 using vec4 = glm::vec4;
+using scalar = float;
 }  // namespace detail
 
 struct FrameBlock {
@@ -142,7 +161,12 @@ struct FrameBlock {
   DOWNPOUR_FRAME_BLOCK(DOWNPOUR_BLOCK_FIELD)
 #undef DOWNPOUR_BLOCK_FIELD
 };
-static_assert(sizeof(FrameBlock) % 16 == 0, "std140: vec4 and mat4 fields only");
+static_assert(sizeof(FrameBlock) % 16 == 0, "std140: the block fills whole vec4 slots");
+#define DOWNPOUR_BLOCK_ALIGNED(type, name, what)                                             \
+  static_assert(std::is_same_v<detail::type, float> || offsetof(FrameBlock, name) % 16 == 0, \
+                "std140: a vec4 or mat4 field starts on 16 bytes: keep scalars in fours");
+DOWNPOUR_FRAME_BLOCK(DOWNPOUR_BLOCK_ALIGNED)
+#undef DOWNPOUR_BLOCK_ALIGNED
 
 struct LampBlock {
   glm::vec4 count{0.0f};  // x the ego car's headlights, y all the lamps

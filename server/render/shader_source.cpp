@@ -53,6 +53,10 @@ void resolve_into(const std::string& file, int depth, ShaderSource& out) {
 
 }  // namespace
 
+std::string glsl_type(std::string_view listed) {
+  return listed == "scalar" ? "float" : std::string(listed);
+}
+
 ShaderSource resolve_shader(const std::string& file) {
   ShaderSource out;
   resolve_into(file, 0, out);
@@ -62,18 +66,22 @@ ShaderSource resolve_shader(const std::string& file) {
 std::string interface_glsl() {
   std::string s =
       "// Generated from server/render/shader_interface.hpp: the per-frame uniform block, the\n"
-      "// texture units, the material ids and the storage buffers' bindings. Do not edit.\n";
+      "// texture units, the material ids, the storage buffers' bindings and the arrays' sizes.\n"
+      "// Do not edit.\n";
+#define DOWNPOUR_GLSL_SIZE(name, size, glsl, what) \
+  s += std::string("const int ") + #glsl + " = " + std::to_string(size) + ";  // " + what + "\n";
+  DOWNPOUR_ARRAY_SIZES(DOWNPOUR_GLSL_SIZE)
+#undef DOWNPOUR_GLSL_SIZE
   s +=
       "layout(std140, binding = " + std::to_string(kFrameBlockBinding) + ") uniform FrameBlock {\n";
 #define DOWNPOUR_GLSL_FIELD(type, name, what) \
-  s += std::string("  ") + #type + " " + #name + ";  // " + what + "\n";
+  s += "  " + glsl_type(#type) + " " + #name + ";  // " + what + "\n";
   DOWNPOUR_FRAME_BLOCK(DOWNPOUR_GLSL_FIELD)
 #undef DOWNPOUR_GLSL_FIELD
   s += "} frame;\n";
   s += "layout(std140, binding = " + std::to_string(kLampBlockBinding) +
        ") uniform LampBlock {\n  vec4 count;  // x the ego car's headlights, y all the lamps\n"
-       "  vec4 lamp[" +
-       std::to_string(4 * kMaxLamps) + "];  // four per lamp (shader_interface.hpp)\n} lamps;\n";
+       "  vec4 lamp[4 * MAX_LAMPS];  // four per lamp (shader_interface.hpp)\n} lamps;\n";
 #define DOWNPOUR_GLSL_UNIT(name, unit, type, glsl, what)                                      \
   s += std::string("layout(binding = ") + std::to_string(unit) + ") uniform " + #type + " " + \
        #glsl + ";  // " + what + "\n";

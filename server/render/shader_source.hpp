@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace downpour::render {
@@ -21,6 +22,8 @@ std::string interface_glsl();
 
 // The names of every embedded shader file.
 std::vector<std::string> shader_files();
+// A frame-block field's GLSL type from its type in shader_interface.hpp's list (scalar: float).
+std::string glsl_type(std::string_view listed);
 
 // A driver's log with its "N:line" source numbers replaced by file names.
 std::string name_files_in_log(const std::string& log, const ShaderSource& source);

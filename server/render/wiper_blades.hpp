@@ -4,6 +4,7 @@
 #include <array>
 
 #include "server/render/gl_objects.hpp"
+#include "server/render/shader_interface.hpp"
 #include "server/sim/windshield.hpp"
 
 namespace downpour::render {
@@ -13,11 +14,11 @@ namespace downpour::render {
 class WiperBladeUniforms {
  public:
   explicit WiperBladeUniforms(const ShaderProgram& program);
-  void set(const std::array<sim::BladePose, 2>& blades) const;
+  void set(const std::array<sim::BladePose, kWiperBlades>& blades) const;
 
  private:
-  std::array<Uniform, 2> pivot_dir_;
-  std::array<Uniform, 2> size_;
+  std::array<Uniform, kWiperBlades> pivot_dir_;
+  std::array<Uniform, kWiperBlades> size_;
 };
 
 }  // namespace downpour::render

@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 
 #include "server/render/light_set.hpp"
+#include "server/render/shader_interface.hpp"
 
 namespace downpour::render {
 
@@ -43,12 +44,13 @@ void lamp_glows(const std::vector<Light>& lights, const glm::vec3& camera, float
     g.core = haze * std::clamp(0.35f + 0.65f * std::sqrt(peak / 60.0f), 0.35f, 1.0f);
     glows.push_back(g);
   }
-  if (glows.size() > kMaxGlows) {
-    std::partial_sort(glows.begin(), glows.begin() + kMaxGlows, glows.end(),
+  constexpr auto kMost = static_cast<std::size_t>(kMaxGlows);
+  if (glows.size() > kMost) {
+    std::partial_sort(glows.begin(), glows.begin() + kMost, glows.end(),
                       [](const LampGlow& a, const LampGlow& b) {
                         return a.colour_strength.w > b.colour_strength.w;
                       });
-    glows.resize(kMaxGlows);
+    glows.resize(kMost);
   }
 }
 

@@ -33,9 +33,8 @@ float lamp_glare(const Light& light, const glm::vec3& camera, float lux_exposure
 
 // The glows of the frame's lamps seen from `camera` in a view `height` pixels high with the
 // vertical half-angle tan_half_fov_y, under the frame's exposure (radiance per lux) and haze
-// (extinction per metre); at most kMaxGlows, the strongest. Into `glows` (cleared first: kept
-// from frame to frame, no allocation once it has grown).
-inline constexpr std::size_t kMaxGlows = 96;
+// (extinction per metre); at most kMaxGlows (shader_interface.hpp), the strongest. Into `glows`
+// (cleared first: kept from frame to frame, no allocation once it has grown).
 void lamp_glows(const std::vector<Light>& lights, const glm::vec3& camera, float tan_half_fov_y,
                 int height, float lux_exposure, float haze_per_m, std::vector<LampGlow>& glows);
 

@@ -1,6 +1,7 @@
 // The generated GLSL side of the renderer's interface (shader_interface.hpp): every texture unit,
 // material id, storage buffer and frame-block field the C++ lists name, with the value the C++
 // uses.
+#include <regex>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -38,8 +39,8 @@ TEST(ShaderInterfaceTest, TheGeneratedGlslDeclaresWhatTheCppLists) {
   ++materials;
   DOWNPOUR_MATERIALS(EXPECT_MATERIAL)
 #undef EXPECT_MATERIAL
-#define EXPECT_FIELD(type, name, what)                                                             \
-  EXPECT_NE(glsl.find(std::string("  ") + #type + " " + #name + ";"), std::string::npos) << #name; \
+#define EXPECT_FIELD(type, name, what)                                                           \
+  EXPECT_NE(glsl.find("  " + glsl_type(#type) + " " + #name + ";"), std::string::npos) << #name; \
   ++fields;
   DOWNPOUR_FRAME_BLOCK(EXPECT_FIELD)
 #undef EXPECT_FIELD
@@ -53,7 +54,28 @@ TEST(ShaderInterfaceTest, TheGeneratedGlslDeclaresWhatTheCppLists) {
   EXPECT_NE(glsl.find("layout(std140, binding = " + std::to_string(kLampBlockBinding) +
                       ") uniform LampBlock {"),
             std::string::npos);
-  EXPECT_NE(glsl.find("vec4 lamp[" + std::to_string(4 * kMaxLamps) + "];"), std::string::npos);
+  EXPECT_NE(glsl.find("vec4 lamp[4 * MAX_LAMPS];"), std::string::npos);
+  int sizes = 0;
+#define EXPECT_SIZE(name, size, constant, what)                                                    \
+  EXPECT_NE(glsl.find(std::string("const int ") + #constant + " = " + std::to_string(name) + ";"), \
+            std::string::npos)                                                                     \
+      << #constant;                                                                                \
+  ++sizes;
+  DOWNPOUR_ARRAY_SIZES(EXPECT_SIZE)
+#undef EXPECT_SIZE
+  EXPECT_EQ(sizes, 3);
+}
+
+// The shaders size their uniform arrays by the generated constants, never by a number of their own.
+TEST(ShaderInterfaceTest, NoShaderSizesAUniformArrayWithALiteral) {
+  const std::regex literal_size(R"(uniform\s+\w+\s+\w+\s*\[\s*[0-9]+\s*\])");
+  int files = 0;
+  for (const std::string& file : shader_files()) {
+    const ShaderSource source = resolve_shader(file);
+    EXPECT_FALSE(std::regex_search(source.text, literal_size)) << file;
+    ++files;
+  }
+  EXPECT_GE(files, 30);
 }
 
 TEST(ShaderInterfaceTest, NoTwoTextureUnitsOrStorageBuffersShareABinding) {
