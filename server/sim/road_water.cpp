@@ -259,24 +259,12 @@ void RoadWater::trim_records(glm::dvec2 centre) {
   }
 }
 
+// Moving the windows with the car: the first placement fills them
+// from the surface; a later one keeps the levels that stay, fills the new cells and hands each
+// cell's water on from where the old windows (or the records, or the rain) held it.
 void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origins) {
-  const int n = n_;
   if (!placed_) {
-    origins_ = origins;
-    for (int l = 0; l < levels_; ++l) {
-      sample_window(l);
-      for (int j = 0; j < n; ++j) {
-        for (int i = 0; i < n; ++i) {
-          const glm::ivec2 q = origins[l] + glm::ivec2(i, j);
-          const std::size_t c = flat(l, i, j);
-          owned_[c] = l == 0 || !inside(origins, l - 1, 2 * q);
-          if (owned_[c] && paved_[c] && config_.initial_m > 0.0) {
-            water_[c] = config_.initial_m;
-            ledger_.rain_in_m3 += config_.initial_m * area(l);
-          }
-        }
-      }
-    }
+    place_first(origins);
     placed_ = true;
     return;
   }
@@ -287,11 +275,38 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
   const std::size_t count = old_water_.size();
   ground_.assign(count, 0.0), water_.assign(count, 0.0), places_.assign(count, RoadPlace{});
   hollow_.assign(count, 0.0), paved_.assign(count, 0), owned_.assign(count, 0);
+  const std::array<bool, kRoadWaterMaxLevels> moved = keep_levels_that_stay();
+  const UnseenWater unseen = unseen_water();
+  fill_new_cells(moved);
+  record_water_left_behind(moved);
+  hand_water_on(moved, unseen);
+}
+
+void RoadWater::place_first(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origins) {
+  const int n = n_;
+  origins_ = origins;
+  for (int l = 0; l < levels_; ++l) {
+    sample_window(l);
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const glm::ivec2 q = origins[l] + glm::ivec2(i, j);
+        const std::size_t c = flat(l, i, j);
+        owned_[c] = l == 0 || !inside(origins, l - 1, 2 * q);
+        if (owned_[c] && paved_[c] && config_.initial_m > 0.0) {
+          water_[c] = config_.initial_m;
+          ledger_.rain_in_m3 += config_.initial_m * area(l);
+        }
+      }
+    }
+  }
+}
+
+std::array<bool, kRoadWaterMaxLevels> RoadWater::keep_levels_that_stay() {
   // A level whose window stays, under a finer one that stays, keeps its cells as they are (the
   // finest windows move most often: most moves leave the coarse ones).
   std::array<bool, kRoadWaterMaxLevels> moved{};
   for (int l = 0; l < levels_; ++l) {
-    moved[l] = origins[l] != old_origins_[l] || (l > 0 && origins[l - 1] != old_origins_[l - 1]);
+    moved[l] = origins_[l] != old_origins_[l] || (l > 0 && origins_[l - 1] != old_origins_[l - 1]);
     if (moved[l]) continue;
     const std::size_t from = l * layer(), to = (l + 1) * layer();
     std::copy(old_ground_.begin() + from, old_ground_.begin() + to, ground_.begin() + from);
@@ -301,7 +316,11 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
     std::copy(old_paved_.begin() + from, old_paved_.begin() + to, paved_.begin() + from);
     std::copy(old_owned_.begin() + from, old_owned_.begin() + to, owned_.begin() + from);
   }
+  return moved;
+}
 
+RoadWater::UnseenWater RoadWater::unseen_water() const {
+  const std::size_t count = old_water_.size();
   // What the road the windows never saw holds: the rain fell there as here, so the mean (by area)
   // of the paved cells, and of the film running over their hollows (the films shared out below).
   double sum = 0.0, film_sum = 0.0, counted = 0.0;
@@ -313,9 +332,13 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
     film_sum += (standing - held_m(old_water_[c], old_hollow_[c], c >= layer())) * a;
     counted += a;
   }
-  const double fresh_m = counted > 0.0 ? sum / counted : 0.0;
-  const double film_m = counted > 0.0 ? film_sum / counted : 0.0;
+  if (counted <= 0.0) return {};
+  return {sum / counted, film_sum / counted};
+}
 
+void RoadWater::fill_new_cells(const std::array<bool, kRoadWaterMaxLevels>& moved) {
+  const int n = n_;
+  const std::array<glm::ivec2, kRoadWaterMaxLevels>& origins = origins_;
   // The new windows' cells: their ground from the old windows' where they were in them, else from
   // the surface (the guess from the nearest old cell); which of them hold their place's water.
   for (int l = 0; l < levels_; ++l) {
@@ -343,6 +366,11 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
       }
     }
   }
+}
+
+void RoadWater::record_water_left_behind(const std::array<bool, kRoadWaterMaxLevels>& moved) {
+  const int n = n_;
+  const std::array<glm::ivec2, kRoadWaterMaxLevels>& origins = origins_;
   // The old windows' water that no new window holds goes to the records (before any record is
   // shared out below: those are others). (A level that stays lies in the last window.)
   for (int l = 0; l < levels_; ++l) {
@@ -356,6 +384,13 @@ void RoadWater::move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origi
       }
     }
   }
+}
+
+void RoadWater::hand_water_on(const std::array<bool, kRoadWaterMaxLevels>& moved,
+                              const UnseenWater& unseen) {
+  const int n = n_;
+  const std::array<glm::ivec2, kRoadWaterMaxLevels>& origins = origins_;
+  const double fresh_m = unseen.fresh_m, film_m = unseen.film_m;
   // Each new cell that holds its place's water takes it from where the old windows held it: the
   // same cell, the finer cells a ring held (their sum), or a share of the coarser cell or record
   // that held it (shared out below, among all the cells it goes to).

@@ -188,6 +188,23 @@ class RoadWater {
     return d.x >= 0 && d.y >= 0 && d.x < n_ && d.y < n_;
   }
   void move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origins);
+  // move_to's steps. The first placement: every window from the surface, the initial film.
+  void place_first(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origins);
+  // Copies the levels whose windows (and the finer ones') stay; which levels moved.
+  std::array<bool, kRoadWaterMaxLevels> keep_levels_that_stay();
+  // The mean water (and film over the hollows) of the old windows' paved cells, by area (m): what
+  // road the windows never saw holds, as the rain fell there as here.
+  struct UnseenWater {
+    double fresh_m = 0.0, film_m = 0.0;
+  };
+  UnseenWater unseen_water() const;
+  // The moved levels' new cells: ground, paving and place from the old windows or the surface,
+  // and which cells hold their place's water.
+  void fill_new_cells(const std::array<bool, kRoadWaterMaxLevels>& moved);
+  // The old windows' water that no new window holds, to the records.
+  void record_water_left_behind(const std::array<bool, kRoadWaterMaxLevels>& moved);
+  // Each new cell's water from where the old windows, the records or the rain held it.
+  void hand_water_on(const std::array<bool, kRoadWaterMaxLevels>& moved, const UnseenWater& unseen);
   // A level's whole window from the surface.
   void sample_window(int level);
   // A cell's ground, whether paved and its place on the roads, from the surface (guess: a place
