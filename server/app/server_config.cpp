@@ -50,8 +50,8 @@ std::string security_problem(const ServerConfig& c) {
   if (!rpc::loopback_only(c.listen) && !c.allow_insecure_remote &&
       (c.tls_cert.empty() || c.tokens_file.empty())) {
     return "listening on " + c.listen +
-           " reaches other machines: give --tls-cert, --tls-key and --tokens-file (README, "
-           "Exposing the server), or --allow-insecure-remote on a network you trust";
+           " reaches other machines: give --tls-cert, --tls-key and --tokens-file (docs/"
+           "operations.md, Security), or --allow-insecure-remote on a network you trust";
   }
   return {};
 }

@@ -43,7 +43,7 @@ struct ServerConfig {
   double max_memory_mb = 0.0;
   // Health turns NOT_SERVING while the render loop has not come round for this long; 0 = off.
   double watchdog_s = 10.0;
-  // Security (README, Exposing the server). A listen address other than loopback needs TLS and a
+  // Security (docs/operations.md, Security). A listen address other than loopback needs TLS and a
   // tokens file, unless allow_insecure_remote says otherwise.
   std::string tokens_file;    // bearer tokens, principals and roles (rpc/auth.hpp)
   std::string tls_cert;       // PEM: the server's certificate chain ...

@@ -17,10 +17,10 @@ struct SessionCost {
 // A lockstep session is counted at the fps it was created with (the step rate its client expects),
 // this one if none. Alone on an empty server, any session passes the pixel-rate budget.
 constexpr double kLockstepNominalFps = 30.0;
-// Measured on the server (README, Admission): resident memory per pixel of a view (its targets,
-// the glass passes' targets, readback buffers, the encoder's copy and output) and per session
-// (the simulation, the glass water map, the session's GL state); and, beside those 16 MB, the
-// water's surface on the GPU (some 3 MB in heavy rain) and the environment probe (1.2 MB).
+// Measured on the server (docs/operations.md, Admission): resident memory per pixel of a view (its
+// targets, the glass passes' targets, readback buffers, the encoder's copy and output) and per
+// session (the simulation, the glass water map, the session's GL state); and, beside those 16 MB,
+// the water's surface on the GPU (some 3 MB in heavy rain) and the environment probe (1.2 MB).
 constexpr double kBytesPerViewPixel = 20.0;
 constexpr double kBytesPerSession = 20.0 * 1024 * 1024;
 

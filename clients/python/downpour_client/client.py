@@ -79,8 +79,8 @@ class DownpourClient:
     $DOWNPOUR_TLS_CA); tls_cert and tls_key: this client's certificate, for mutual TLS.
     stream_window_kib: the most frame data gRPC takes in ahead of the reader, per stream. A
     reader that pauses finds at most this much of old frames waiting before the latest, instead of
-    the megabytes a window grown by gRPC's bandwidth probe holds (README, Frames and flow
-    control). 0 keeps gRPC's own (faster over long, fast links). channel_options: more gRPC
+    the megabytes a window grown by gRPC's bandwidth probe holds (docs/contract.md, A reader
+    that pauses). 0 keeps gRPC's own (faster over long, fast links). channel_options: more gRPC
     channel arguments, (name, value) pairs (e.g. ("grpc.lb_policy_name", "round_robin")).
 
     Scale-out: a server started with --advertise names itself in SessionInfo.endpoint, and every

@@ -1,4 +1,4 @@
-"""The command-line options of a protected server (README, Exposing the server)."""
+"""The command-line options of a protected server (docs/operations.md, Security)."""
 
 
 def add_security_arguments(parser):
