@@ -1,5 +1,6 @@
 #include "server/rpc/validation.hpp"
 
+#include <array>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -134,15 +135,26 @@ grpc::Status to_wipers(const v1::WiperState& in, const std::string& field, sim::
   return grpc::Status::OK;
 }
 
-// Each field as sim/weather.hpp defines it, found in the message by its name (a unit test checks
-// that the two lists agree).
+// The contract's field for each of sim/weather.hpp's, found by its name once (a unit test checks
+// that the two lists agree; a name missing from the contract stays null).
+const std::array<const google::protobuf::FieldDescriptor*, sim::kWeatherFields.size()>&
+weather_wire_fields() {
+  static const auto fields = [] {
+    std::array<const google::protobuf::FieldDescriptor*, sim::kWeatherFields.size()> found{};
+    for (std::size_t i = 0; i < found.size(); ++i)
+      found[i] =
+          v1::Weather::descriptor()->FindFieldByName(std::string(sim::kWeatherFields[i].name));
+    return found;
+  }();
+  return fields;
+}
+
 grpc::Status to_weather(const v1::Weather& in, const std::string& f, sim::Weather* out) {
-  const google::protobuf::Descriptor* message = in.GetDescriptor();
   const google::protobuf::Reflection* reflection = in.GetReflection();
   sim::Weather w;
-  for (const sim::WeatherField& field : sim::kWeatherFields) {
-    const google::protobuf::FieldDescriptor* wire =
-        message->FindFieldByName(std::string(field.name));
+  for (std::size_t i = 0; i < sim::kWeatherFields.size(); ++i) {
+    const sim::WeatherField& field = sim::kWeatherFields[i];
+    const google::protobuf::FieldDescriptor* wire = weather_wire_fields()[i];
     if (wire == nullptr) {
       return grpc::Status(grpc::StatusCode::INTERNAL,
                           "weather field " + std::string(field.name) + " is not in the contract");

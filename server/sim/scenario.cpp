@@ -16,11 +16,6 @@ namespace {
 
 using nlohmann::json;
 
-double lerp_angle_deg(double a, double b, double u) {
-  const double d = std::remainder(b - a, 360.0);  // in [-180, 180]
-  return a + d * u;
-}
-
 VehicleState mix(const VehicleState& a, const VehicleState& b, double u) {
   VehicleState v;
   v.position_m = a.position_m + (b.position_m - a.position_m) * u;

@@ -81,11 +81,17 @@ inline constexpr std::array kWeatherFields = {
 #undef DOWNPOUR_WEATHER_ROW
 };
 
+// From angle a towards b the shorter way round (degrees), at fraction u; the result is not
+// wrapped. Scenarios carry the vehicle's rotation this way too.
+inline double lerp_angle_deg(double a, double b, double u) {
+  return a + std::remainder(b - a, 360.0) * u;
+}
+
 // One field's value between keyframes a and b at fraction u, as its interpolation says.
 inline double interpolate(const WeatherField& f, double a, double b, double u) {
   switch (f.interpolation) {
     case Interpolation::kAngle:
-      return a + std::remainder(b - a, 360.0) * u;
+      return lerp_angle_deg(a, b, u);
     case Interpolation::kRound:
       return std::round(a + (b - a) * u);
     case Interpolation::kLinear:
