@@ -143,6 +143,27 @@ class RainLayer {
   static constexpr int kMaxSplashSteps = 6;
   // Below this many drops one thread draws them all.
   static constexpr std::size_t kDropsForTwoThreads = 4096;
+  // A batch of drops being projected (rain_layer.cpp).
+  struct Batch;
+
+  // What stays the same for every drop of one build: the camera, the drops' motion in its frame,
+  // the projection, the copies of the box, the haze table, the lamps (rain_layer.cpp).
+  struct Frame;
+  // The layer sized width x height, its texels clear and last build's output cleared.
+  void reset(int width, int height);
+  // Draws drops [begin, end) into `out`, in batches; `dirty` gets the texels it touched. Returns
+  // the streaks drawn.
+  std::uint32_t draw(const Frame& f, std::size_t begin, std::size_t end, std::vector<Texel>& out,
+                     Bounds& dirty, Batch& batch) const;
+  // One streak (copy c of drop i of the batch) as a Wu line into `out`, widening `touched`.
+  void draw_streak(const Frame& f, const Batch& batch, int c, int i, std::vector<Texel>& out,
+                   Bounds& touched) const;
+  // The texels of `b` to premultiplied colour, both threads' texels summed and cleared, and the
+  // tiles with rain marked.
+  void resolve(const Frame& f, const RainLayerInputs& in, const Bounds& b);
+  void resolve_rows(const Frame& f, const RainLayerInputs& in, const Bounds& b, int y0, int y1);
+  // The runs of tiles the composite draws (runs_), from the tiles marked in `b`.
+  void make_runs(const RainLayerInputs& in, const Bounds& b);
 
   // Splats the splashes' crowns into texels_, after the streaks, each point along its motion
   // relative to the camera during the exposure; returns the texels touched. Those on the car
@@ -160,7 +181,6 @@ class RainLayer {
   Bounds occluded_;
   sim::WorkerThread helper_;
   // Each thread's batch of drops being projected (rain_layer.cpp), made once.
-  struct Batch;
   std::unique_ptr<Batch> batches_[2];  // draws half the drops, resolves half the rows
   std::vector<Texel> texels_;
   std::vector<Texel> second_;  // the second thread's
