@@ -12,11 +12,11 @@
 #include <CLI/CLI.hpp>
 
 #include "bench/stats.hpp"
-#include "server/render/atmosphere.hpp"
-#include "server/render/cabin_tiles.hpp"
-#include "server/render/camera.hpp"
+#include "server/render/cpu/atmosphere.hpp"
+#include "server/render/cpu/cabin_tiles.hpp"
+#include "server/render/cpu/camera.hpp"
 #include "server/render/passes/rain_pass.hpp"
-#include "server/render/vehicle_geometry.hpp"
+#include "server/render/cpu/vehicle_geometry.hpp"
 #include "server/sim/pose.hpp"
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"

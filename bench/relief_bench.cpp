@@ -17,7 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/stats.hpp"
-#include "server/render/relief.hpp"
+#include "server/render/cpu/relief.hpp"
 #include "server/render/renderer.hpp"
 #include "server/sim/scenario.hpp"
 

@@ -44,9 +44,9 @@
 #include <glm/trigonometric.hpp>
 
 #include "bench/view_costs.hpp"
-#include "server/render/camera.hpp"
+#include "server/render/cpu/camera.hpp"
 #include "server/render/renderer.hpp"
-#include "server/render/view_wet_fraction.hpp"
+#include "server/render/cpu/view_wet_fraction.hpp"
 #include "server/sim/opendrive_roads.hpp"
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"

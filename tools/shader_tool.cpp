@@ -5,7 +5,7 @@
 #include <fstream>
 #include <string>
 
-#include "server/render/shader_source.hpp"
+#include "server/render/gl/shader_source.hpp"
 
 int main(int argc, char** argv) {
   if (argc != 2) {

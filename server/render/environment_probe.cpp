@@ -6,8 +6,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "server/render/atmosphere.hpp"
-#include "server/render/shader_interface.hpp"
+#include "server/render/cpu/atmosphere.hpp"
+#include "server/render/cpu/shader_interface.hpp"
 
 namespace downpour::render {
 namespace {

@@ -19,8 +19,8 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-#include "server/render/camera.hpp"
-#include "server/render/gl_objects.hpp"
+#include "server/render/cpu/camera.hpp"
+#include "server/render/gl/gl_objects.hpp"
 
 namespace downpour::render {
 

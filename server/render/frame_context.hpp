@@ -9,10 +9,10 @@
 #include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
 
-#include "server/render/atmosphere.hpp"
-#include "server/render/camera.hpp"
-#include "server/render/gl_objects.hpp"
-#include "server/render/glass_view.hpp"
+#include "server/render/cpu/atmosphere.hpp"
+#include "server/render/cpu/camera.hpp"
+#include "server/render/gl/gl_objects.hpp"
+#include "server/render/cpu/glass_view.hpp"
 #include "server/sim/simulation.hpp"
 
 namespace downpour::render {

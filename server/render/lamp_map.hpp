@@ -19,7 +19,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-#include "server/render/gl_objects.hpp"
+#include "server/render/gl/gl_objects.hpp"
 
 namespace downpour::render {
 

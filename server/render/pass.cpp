@@ -4,7 +4,7 @@
 #include <iterator>
 #include <stdexcept>
 
-#include "server/render/shader_interface.hpp"
+#include "server/render/cpu/shader_interface.hpp"
 
 namespace downpour::render {
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "server/render/frame_context.hpp"
-#include "server/render/render_state.hpp"
+#include "server/render/gl/render_state.hpp"
 
 namespace downpour::render {
 

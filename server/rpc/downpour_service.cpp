@@ -6,7 +6,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "server/render/world_geometry.hpp"
+#include "server/render/cpu/world_geometry.hpp"
 #include "server/rpc/convert.hpp"
 #include "server/rpc/drive_reactor.hpp"
 #include "server/rpc/session_access.hpp"

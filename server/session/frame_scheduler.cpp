@@ -8,9 +8,9 @@
 
 #include <spdlog/spdlog.h>
 
-#include "server/render/atmosphere.hpp"
-#include "server/render/view_road_states.hpp"
-#include "server/render/view_wet_fraction.hpp"
+#include "server/render/cpu/atmosphere.hpp"
+#include "server/render/cpu/view_road_states.hpp"
+#include "server/render/cpu/view_wet_fraction.hpp"
 #include "server/sim/glass_water_surface.hpp"
 
 namespace downpour::session {

@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 #include <glm/trigonometric.hpp>
 
-#include "server/render/camera.hpp"
+#include "server/render/cpu/camera.hpp"
 #include "server/sim/pose.hpp"
 #include "tests/render/render_fixture.hpp"
 

@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
 
-#include "server/render/spray_splat.hpp"
+#include "server/render/cpu/spray_splat.hpp"
 #include "tests/render/render_fixture.hpp"
 #include "tests/support/spray_drive.hpp"
 

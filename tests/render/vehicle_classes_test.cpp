@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 #include <glm/trigonometric.hpp>
 
-#include "server/render/camera.hpp"
+#include "server/render/cpu/camera.hpp"
 #include "server/sim/pose.hpp"
 #include "server/sim/vehicle_class.hpp"
 #include "tests/render/render_fixture.hpp"

@@ -1,14 +1,14 @@
 // The fraction of a COCKPIT view hidden by water, from the water's surface on the glass: none
 // without water, all of it through a glass wholly wet, about half through a glass wet on one side
 // or half covered by drops.
-#include "server/render/view_wet_fraction.hpp"
+#include "server/render/cpu/view_wet_fraction.hpp"
 
 #include <cmath>
 #include <memory>
 
 #include <gtest/gtest.h>
 
-#include "server/render/camera.hpp"
+#include "server/render/cpu/camera.hpp"
 #include "server/sim/drop_physics.hpp"
 #include "server/sim/glass_water_surface.hpp"
 

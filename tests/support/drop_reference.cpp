@@ -5,7 +5,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "server/render/display.hpp"
+#include "server/render/cpu/display.hpp"
 
 namespace downpour::testing {
 namespace {

@@ -1,6 +1,6 @@
 #include "server/render/passes/cockpit_pass.hpp"
 
-#include "server/render/vehicle_geometry.hpp"
+#include "server/render/cpu/vehicle_geometry.hpp"
 
 namespace downpour::render {
 

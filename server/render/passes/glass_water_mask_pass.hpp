@@ -2,7 +2,7 @@
 
 #include <memory>
 
-#include "server/render/glass_quad.hpp"
+#include "server/render/passes/glass_quad.hpp"
 #include "server/render/pass.hpp"
 
 namespace downpour::render {

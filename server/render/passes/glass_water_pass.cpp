@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "server/render/atmosphere.hpp"
+#include "server/render/cpu/atmosphere.hpp"
 #include "server/sim/glass_water_surface.hpp"
 
 namespace downpour::render {

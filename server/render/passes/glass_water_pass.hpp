@@ -4,7 +4,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "server/render/glass_quad.hpp"
+#include "server/render/passes/glass_quad.hpp"
 #include "server/render/pass.hpp"
 
 namespace downpour::render {

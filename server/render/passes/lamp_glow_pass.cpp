@@ -5,8 +5,8 @@
 
 #include <glm/geometric.hpp>
 
-#include "server/render/light_set.hpp"
-#include "server/render/shader_interface.hpp"
+#include "server/render/cpu/light_set.hpp"
+#include "server/render/cpu/shader_interface.hpp"
 
 namespace downpour::render {
 

@@ -7,10 +7,10 @@
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "server/render/cabin_tiles.hpp"
-#include "server/render/light_set.hpp"
-#include "server/render/shader_interface.hpp"
-#include "server/render/vehicle_geometry.hpp"
+#include "server/render/cpu/cabin_tiles.hpp"
+#include "server/render/cpu/light_set.hpp"
+#include "server/render/cpu/shader_interface.hpp"
+#include "server/render/cpu/vehicle_geometry.hpp"
 #include "server/sim/car_body.hpp"
 #include "server/sim/pose.hpp"
 

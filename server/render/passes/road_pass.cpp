@@ -5,8 +5,8 @@
 
 #include <glm/trigonometric.hpp>
 
-#include "server/render/light_set.hpp"
-#include "server/render/relief.hpp"
+#include "server/render/cpu/light_set.hpp"
+#include "server/render/cpu/relief.hpp"
 #include "server/render/world.hpp"
 
 namespace downpour::render {

@@ -6,7 +6,7 @@
 #include <string>
 #include <string_view>
 
-#include "server/render/shader_interface.hpp"
+#include "server/render/cpu/shader_interface.hpp"
 
 namespace downpour::render {
 namespace {

@@ -4,8 +4,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "server/render/light_set.hpp"
-#include "server/render/vehicle_geometry.hpp"
+#include "server/render/cpu/light_set.hpp"
+#include "server/render/cpu/vehicle_geometry.hpp"
 #include "server/sim/pose.hpp"
 #include "server/sim/vehicle_class.hpp"
 

@@ -1,6 +1,6 @@
 #include "server/render/passes/windshield_pass.hpp"
 
-#include "server/render/glass_quad.hpp"
+#include "server/render/passes/glass_quad.hpp"
 
 namespace downpour::render {
 

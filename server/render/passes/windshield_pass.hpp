@@ -1,8 +1,8 @@
 #pragma once
 
-#include "server/render/glass_quad.hpp"
+#include "server/render/passes/glass_quad.hpp"
 #include "server/render/pass.hpp"
-#include "server/render/wiper_blades.hpp"
+#include "server/render/passes/wiper_blades.hpp"
 
 namespace downpour::render {
 

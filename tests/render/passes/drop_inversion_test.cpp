@@ -11,8 +11,8 @@
 
 #include <gtest/gtest.h>
 
-#include "server/render/camera.hpp"
-#include "server/render/glass_view.hpp"
+#include "server/render/cpu/camera.hpp"
+#include "server/render/cpu/glass_view.hpp"
 #include "server/sim/glass_water_surface.hpp"
 #include "server/sim/pose.hpp"
 #include "tests/render/render_fixture.hpp"

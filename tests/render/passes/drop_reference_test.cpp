@@ -10,8 +10,8 @@
 
 #include <gtest/gtest.h>
 
-#include "server/render/atmosphere.hpp"
-#include "server/render/camera.hpp"
+#include "server/render/cpu/atmosphere.hpp"
+#include "server/render/cpu/camera.hpp"
 #include "server/render/environment_probe.hpp"
 #include "server/render/passes/glass_water_pass.hpp"
 #include "server/sim/glass_water_surface.hpp"

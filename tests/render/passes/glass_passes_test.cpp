@@ -8,8 +8,8 @@
 
 #include <gtest/gtest.h>
 
-#include "server/render/camera.hpp"
-#include "server/render/glass_view.hpp"
+#include "server/render/cpu/camera.hpp"
+#include "server/render/cpu/glass_view.hpp"
 #include "server/render/renderer.hpp"
 #include "server/sim/pose.hpp"
 #include "tests/render/render_fixture.hpp"

@@ -1,13 +1,13 @@
 // The cabin's tiles in the driver's view, from its mesh on the CPU: the dashboard's and the roof's
 // are hidden, the road's ahead through the glass is clear, and between them lie edge tiles.
-#include "server/render/cabin_tiles.hpp"
+#include "server/render/cpu/cabin_tiles.hpp"
 
 #include <cstdio>
 #include <utility>
 
 #include <gtest/gtest.h>
 
-#include "server/render/vehicle_geometry.hpp"
+#include "server/render/cpu/vehicle_geometry.hpp"
 #include "server/sim/types.hpp"
 
 namespace downpour::render {

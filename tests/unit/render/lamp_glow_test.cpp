@@ -8,7 +8,7 @@
 #include <glm/trigonometric.hpp>
 
 #include "server/render/lamp_map.hpp"
-#include "server/render/light_set.hpp"
+#include "server/render/cpu/light_set.hpp"
 #include "server/render/passes/lamp_glow_pass.hpp"
 
 namespace downpour::render {

@@ -1,6 +1,6 @@
 // The frame's lamps from the scene (which are lit, where, aimed how) and their binning into screen
 // tiles: a lamp in view lands in the tiles around it and no others, one behind the camera in none.
-#include "server/render/light_set.hpp"
+#include "server/render/cpu/light_set.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -10,7 +10,7 @@
 #include <glm/matrix.hpp>
 #include <glm/trigonometric.hpp>
 
-#include "server/render/camera.hpp"
+#include "server/render/cpu/camera.hpp"
 #include "server/sim/vehicle_class.hpp"
 
 namespace downpour::render {

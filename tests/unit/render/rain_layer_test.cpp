@@ -1,9 +1,9 @@
 // The rain layer on the CPU (no GL): a box hides the streaks behind it and not those in front of
 // it, on the texels inside its outline; the composite's runs of tiles cover every texel with rain
 // and, for rain in one part of the view, little else; the cabin's tiles are left out or put apart.
-#include "server/render/rain_layer.hpp"
+#include "server/render/cpu/rain_layer.hpp"
 
-#include "server/render/cabin_tiles.hpp"
+#include "server/render/cpu/cabin_tiles.hpp"
 
 #include <gtest/gtest.h>
 #include <glm/ext/matrix_transform.hpp>

@@ -1,7 +1,7 @@
 // Relief shadows (seed 002) against a brute-force reference: a ray marched over the same height
 // field, on a flat surface and on a convex one, and the mesh's principal curvatures against
 // surfaces whose curvatures are known.
-#include "server/render/relief.hpp"
+#include "server/render/cpu/relief.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -13,7 +13,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
-#include "server/render/mesh_curvature.hpp"
+#include "server/render/cpu/mesh_curvature.hpp"
 
 namespace downpour::render::relief {
 namespace {

@@ -1,7 +1,7 @@
 // The road's meshes built from an OpenDRIVE network: lane sections whose lanes differ in number
 // give each its own mesh, whole and indexed within its vertices; a narrow one-sided road's relief
 // is made without a bowl out of its room.
-#include "server/render/scene_geometry.hpp"
+#include "server/render/cpu/scene_geometry.hpp"
 
 #include <memory>
 #include <string>

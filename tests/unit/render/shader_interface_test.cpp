@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "server/render/shader_interface.hpp"
-#include "server/render/shader_source.hpp"
+#include "server/render/cpu/shader_interface.hpp"
+#include "server/render/gl/shader_source.hpp"
 
 namespace downpour::render {
 namespace {

@@ -1,7 +1,7 @@
 // The visible road's states from the view's rays: all dry on a dry road, mostly drench under a
 // film with the puddles counted, adding up to 1 where the road is in sight; a puddle under a car
 // is not seen; nothing in the views that see no road.
-#include "server/render/view_road_states.hpp"
+#include "server/render/cpu/view_road_states.hpp"
 
 #include <chrono>
 #include <cstdio>

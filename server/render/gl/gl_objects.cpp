@@ -1,0 +1,152 @@
+#include "server/render/gl/gl_objects.hpp"
+
+#include <stdexcept>
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include "server/render/gl/shader_source.hpp"
+
+namespace downpour::render {
+
+namespace {
+
+GLuint compile(GLenum stage, const std::string& file) {
+  const ShaderSource source = resolve_shader(file);
+  const GLuint shader = glCreateShader(stage);
+  const char* text = source.text.c_str();
+  glShaderSource(shader, 1, &text, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
+    glDeleteShader(shader);
+    throw std::runtime_error("compiling " + file + ": " + name_files_in_log(log, source));
+  }
+  return shader;
+}
+
+}  // namespace
+
+Texture make_texture_2d(GLenum internal_format, int width, int height, int levels) {
+  GLuint id = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &id);
+  glTextureStorage2D(id, levels, internal_format, width, height);
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, levels > 1 ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR);
+  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  return Texture(id);
+}
+
+Texture make_texture_2d_array(GLenum internal_format, int width, int height, int layers) {
+  GLuint id = 0;
+  glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
+  glTextureStorage3D(id, 1, internal_format, width, height, layers);
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  return Texture(id);
+}
+
+ShaderProgram::ShaderProgram(const std::string& vertex_file, const std::string& fragment_file)
+    : files_(vertex_file + " + " + fragment_file) {
+  const GLuint vs = compile(GL_VERTEX_SHADER, vertex_file);
+  GLuint fs = 0;
+  try {
+    fs = compile(GL_FRAGMENT_SHADER, fragment_file);
+  } catch (...) {
+    glDeleteShader(vs);
+    throw;
+  }
+  const GLuint program = glCreateProgram();
+  glAttachShader(program, vs);
+  glAttachShader(program, fs);
+  glLinkProgram(program);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  program_ = GlName<gl_delete::program>(program);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetProgramInfoLog(program, sizeof(log), nullptr, log);
+    throw std::runtime_error("linking " + files_ + ": " + log);
+  }
+}
+
+Uniform ShaderProgram::uniform(const char* name) const {
+  const GLint location = glGetUniformLocation(program_.id(), name);
+  if (location < 0) throw std::logic_error(files_ + " has no active uniform " + name);
+  return Uniform(program_.id(), location);
+}
+
+void Uniform::set(const glm::mat4& m) const {
+  glProgramUniformMatrix4fv(program_, location_, 1, GL_FALSE, glm::value_ptr(m));
+}
+
+Mesh::Mesh(const MeshData& data)
+    : bounds_min(data.bounds_min),
+      bounds_max(data.bounds_max),
+      index_count_(static_cast<GLsizei>(data.indices.size())) {
+  const auto& vertices = data.vertices;
+  const auto& indices = data.indices;
+  GLuint ids[2];
+  glCreateBuffers(2, ids);
+  vbo_ = Buffer(ids[0]);
+  ibo_ = Buffer(ids[1]);
+  glNamedBufferStorage(vbo_.id(), vertices.size() * sizeof(MeshVertex), vertices.data(), 0);
+  glNamedBufferStorage(ibo_.id(), indices.size() * sizeof(std::uint32_t), indices.data(), 0);
+  GLuint vao = 0;
+  glCreateVertexArrays(1, &vao);
+  vao_ = VertexArray(vao);
+  glVertexArrayVertexBuffer(vao, 0, vbo_.id(), 0, sizeof(MeshVertex));
+  glVertexArrayElementBuffer(vao, ibo_.id());
+  const GLuint offsets[] = {offsetof(MeshVertex, position), offsetof(MeshVertex, normal),
+                            offsetof(MeshVertex, uv)};
+  const GLint sizes[] = {3, 3, 2};
+  for (GLuint a = 0; a < 3; ++a) {
+    glEnableVertexArrayAttrib(vao, a);
+    glVertexArrayAttribFormat(vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
+    glVertexArrayAttribBinding(vao, a, 0);
+  }
+  if (!data.curvature.empty()) {
+    glCreateBuffers(1, ids);
+    curvature_ = Buffer(ids[0]);
+    glNamedBufferStorage(curvature_.id(), data.curvature.size() * sizeof(VertexCurvature),
+                         data.curvature.data(), 0);
+    glVertexArrayVertexBuffer(vao, 1, curvature_.id(), 0, sizeof(VertexCurvature));
+    const GLuint c_offsets[] = {offsetof(VertexCurvature, k1), offsetof(VertexCurvature, v1)};
+    const GLint c_sizes[] = {2, 4};
+    for (GLuint a = 0; a < 2; ++a) {
+      glEnableVertexArrayAttrib(vao, 3 + a);
+      glVertexArrayAttribFormat(vao, 3 + a, c_sizes[a], GL_FLOAT, GL_FALSE, c_offsets[a]);
+      glVertexArrayAttribBinding(vao, 3 + a, 1);
+    }
+  }
+  if (!data.lanes.empty()) {
+    glCreateBuffers(1, ids);
+    lanes_ = Buffer(ids[0]);
+    glNamedBufferStorage(lanes_.id(), data.lanes.size() * sizeof(VertexLane), data.lanes.data(), 0);
+    glVertexArrayVertexBuffer(vao, 2, lanes_.id(), 0, sizeof(VertexLane));
+    glEnableVertexArrayAttrib(vao, 5);
+    glVertexArrayAttribFormat(vao, 5, 4, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(vao, 5, 2);
+  }
+}
+
+void Mesh::draw() const {
+  glBindVertexArray(vao_.id());
+  glDrawElements(GL_TRIANGLES, index_count_, GL_UNSIGNED_INT, nullptr);
+}
+
+FullscreenTriangle::FullscreenTriangle() {
+  GLuint vao = 0;
+  glCreateVertexArrays(1, &vao);
+  vao_ = VertexArray(vao);
+}
+
+void FullscreenTriangle::draw() const {
+  glBindVertexArray(vao_.id());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+}  // namespace downpour::render
