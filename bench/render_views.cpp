@@ -45,8 +45,8 @@
 
 #include "bench/view_costs.hpp"
 #include "server/render/cpu/camera.hpp"
-#include "server/render/renderer.hpp"
 #include "server/render/cpu/view_wet_fraction.hpp"
+#include "server/render/renderer.hpp"
 #include "server/sim/opendrive_roads.hpp"
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"

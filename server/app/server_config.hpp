@@ -8,8 +8,8 @@
 
 #include <grpcpp/security/server_credentials.h>
 
-#include "server/render/gl/egl_context.hpp"
 #include "server/render/cpu/spray_smoothing.hpp"
+#include "server/render/gl/egl_context.hpp"
 #include "server/session/admission.hpp"
 
 namespace downpour::app {

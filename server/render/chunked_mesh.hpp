@@ -7,8 +7,8 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
-#include "server/render/gl/gl_objects.hpp"
 #include "server/render/cpu/mesh_data.hpp"
+#include "server/render/gl/gl_objects.hpp"
 
 namespace downpour::render {
 

@@ -11,8 +11,8 @@
 
 #include "server/render/cpu/atmosphere.hpp"
 #include "server/render/cpu/camera.hpp"
-#include "server/render/gl/gl_objects.hpp"
 #include "server/render/cpu/glass_view.hpp"
+#include "server/render/gl/gl_objects.hpp"
 #include "server/sim/simulation.hpp"
 
 namespace downpour::render {

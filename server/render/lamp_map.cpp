@@ -6,8 +6,8 @@
 
 #include <glm/geometric.hpp>
 
-#include "server/render/gl/render_state.hpp"
 #include "server/render/cpu/shader_interface.hpp"
+#include "server/render/gl/render_state.hpp"
 
 namespace downpour::render {
 

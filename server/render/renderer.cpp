@@ -16,10 +16,13 @@
 #include <spdlog/spdlog.h>
 #include <glm/trigonometric.hpp>
 
+#include "server/render/cpu/light_set.hpp"
+#include "server/render/cpu/procedural_textures.hpp"
+#include "server/render/cpu/relief.hpp"
+#include "server/render/cpu/shader_interface.hpp"
 #include "server/render/environment_probe.hpp"
 #include "server/render/frame_context.hpp"
 #include "server/render/lamp_map.hpp"
-#include "server/render/cpu/light_set.hpp"
 #include "server/render/pass.hpp"
 #include "server/render/passes/cockpit_pass.hpp"
 #include "server/render/passes/environment_background_pass.hpp"
@@ -35,9 +38,6 @@
 #include "server/render/passes/terrain_pass.hpp"
 #include "server/render/passes/vehicle_pass.hpp"
 #include "server/render/passes/windshield_pass.hpp"
-#include "server/render/cpu/procedural_textures.hpp"
-#include "server/render/cpu/relief.hpp"
-#include "server/render/cpu/shader_interface.hpp"
 #include "server/render/world.hpp"
 #include "server/sim/glass_water_surface.hpp"
 #include "server/sim/pose.hpp"

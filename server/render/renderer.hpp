@@ -13,8 +13,8 @@
 
 #include <glm/vec3.hpp>
 
-#include "server/render/gl/egl_context.hpp"
 #include "server/render/cpu/spray_smoothing.hpp"
+#include "server/render/gl/egl_context.hpp"
 #include "server/sim/simulation.hpp"
 #include "server/sim/types.hpp"
 

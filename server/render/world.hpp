@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "server/render/chunked_mesh.hpp"
-#include "server/render/gl/gl_objects.hpp"
 #include "server/render/cpu/world_geometry.hpp"
+#include "server/render/gl/gl_objects.hpp"
 
 namespace downpour::render {
 

@@ -11,8 +11,8 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-#include "server/render/gl/gl.hpp"
 #include "server/render/cpu/mesh_data.hpp"
+#include "server/render/gl/gl.hpp"
 
 namespace downpour::render {
 

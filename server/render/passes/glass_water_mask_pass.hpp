@@ -2,8 +2,8 @@
 
 #include <memory>
 
-#include "server/render/passes/glass_quad.hpp"
 #include "server/render/pass.hpp"
+#include "server/render/passes/glass_quad.hpp"
 
 namespace downpour::render {
 

@@ -4,8 +4,8 @@
 
 #include <glm/vec3.hpp>
 
-#include "server/render/passes/glass_quad.hpp"
 #include "server/render/pass.hpp"
+#include "server/render/passes/glass_quad.hpp"
 
 namespace downpour::render {
 

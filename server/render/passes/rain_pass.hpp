@@ -6,9 +6,9 @@
 
 #include <glm/vec4.hpp>
 
+#include "server/render/cpu/rain_layer.hpp"
 #include "server/render/gl/gl_objects.hpp"
 #include "server/render/pass.hpp"
-#include "server/render/cpu/rain_layer.hpp"
 
 namespace downpour::render {
 

@@ -5,10 +5,10 @@
 
 #include <glm/vec4.hpp>
 
-#include "server/render/gl/gl_objects.hpp"
-#include "server/render/pass.hpp"
 #include "server/render/cpu/spray_smoothing.hpp"
 #include "server/render/cpu/spray_splat.hpp"
+#include "server/render/gl/gl_objects.hpp"
+#include "server/render/pass.hpp"
 #include "server/sim/worker_thread.hpp"
 
 namespace downpour::render {

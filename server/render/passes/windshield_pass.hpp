@@ -1,7 +1,7 @@
 #pragma once
 
-#include "server/render/passes/glass_quad.hpp"
 #include "server/render/pass.hpp"
+#include "server/render/passes/glass_quad.hpp"
 #include "server/render/passes/wiper_blades.hpp"
 
 namespace downpour::render {

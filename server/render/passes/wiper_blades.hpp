@@ -3,8 +3,8 @@
 
 #include <array>
 
-#include "server/render/gl/gl_objects.hpp"
 #include "server/render/cpu/shader_interface.hpp"
+#include "server/render/gl/gl_objects.hpp"
 #include "server/sim/windshield.hpp"
 
 namespace downpour::render {

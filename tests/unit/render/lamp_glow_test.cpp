@@ -7,8 +7,8 @@
 #include <gtest/gtest.h>
 #include <glm/trigonometric.hpp>
 
-#include "server/render/lamp_map.hpp"
 #include "server/render/cpu/light_set.hpp"
+#include "server/render/lamp_map.hpp"
 #include "server/render/passes/lamp_glow_pass.hpp"
 
 namespace downpour::render {
