@@ -8,9 +8,16 @@
 
 #include "server/render/cpu/atmosphere.hpp"
 #include "server/render/cpu/shader_interface.hpp"
+#include "server/render/gl/render_state.hpp"
 
 namespace downpour::render {
 namespace {
+
+// The resolve of a face and its mip levels: no depth, no blending.
+constexpr RenderState kResolveState{DepthTest::kOff, false, Blend::kOff};
+// The lamps over it: spots hidden by the face's depth, added up, their size set by the shader.
+constexpr RenderState kLampsState{
+    DepthTest::kNearerOrEqual, false, Blend::kAdd, true, false, 0, true};
 
 // GL's cube faces: the direction each looks along and its up, so that a face drawn into a
 // framebuffer (rows from the bottom) is the face a lookup along a world direction reads.
@@ -108,9 +115,7 @@ void EnvironmentProbe::resolve(const EnvironmentPrograms& p, int face, const glm
   glViewport(0, 0, config_.face_size, config_.face_size);
   glBindTextureUnit(texture_unit::kViewColour, face_colour_.id());
   glBindTextureUnit(texture_unit::kViewDepth, face_depth_.id());
-  glDisable(GL_DEPTH_TEST);
-  glDepthMask(GL_FALSE);
-  glDisable(GL_BLEND);
+  apply(kResolveState);
   const FaceAxes& a = kFaceAxes.at(static_cast<std::size_t>(face));
   p.resolve_.use();
   p.u_face_.set(glm::mat4(axes * glm::mat3(glm::cross(a.forward, a.up), a.up, a.forward)));
@@ -131,18 +136,11 @@ void EnvironmentProbe::resolve(const EnvironmentPrograms& p, int face, const glm
     glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, face_depth_.id(), 0);
     p.lamps_.use();
     p.u_lamp_texel_rad_.set(texel_rad);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GEQUAL);
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
-    glEnable(GL_PROGRAM_POINT_SIZE);
+    apply(kLampsState);
     glDrawArrays(GL_POINTS, 0, lamps);
-    glDisable(GL_PROGRAM_POINT_SIZE);
-    glDisable(GL_BLEND);
-    glDisable(GL_DEPTH_TEST);
     glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, 0, 0);
   }
-  glDepthMask(GL_TRUE);
+  apply(kResolveState);
   make_levels(p, face);
 }
 

@@ -2,6 +2,7 @@
 // passes share for the renderer's life.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "server/render/cpu/camera.hpp"
 #include "server/render/cpu/glass_view.hpp"
 #include "server/render/gl/gl_objects.hpp"
+#include "server/render/resource.hpp"
 #include "server/sim/simulation.hpp"
 
 namespace downpour::render {
@@ -54,20 +56,25 @@ struct TargetTexture {
   int height = 0;
 };
 
-// The frame's resources by name (pass.hpp's Resource): the renderer binds the framebuffer a pass
-// writes and the textures it reads before the pass runs.
+// A target a pass of the frame drew into: its colour, its depth where it has one, its framebuffer.
+struct FrameTarget {
+  TargetTexture colour;
+  TargetTexture depth;
+  GLuint fbo = 0;
+};
+
+// The frame's resources (resource.hpp): the renderer binds the framebuffer a pass writes and the
+// textures it reads before the pass runs.
 struct FrameResources {
   GLuint view_fbo = 0;
   TargetTexture view_colour;
   TargetTexture view_depth;
-  GLuint glass_layer_fbo = 0;
-  TargetTexture glass_layer;
   TargetTexture environment;  // the session's environment probe (a cube map: a face's size)
   glm::mat3 environment_from_world{1.0f};  // turns world directions into the probe's axes
-  TargetTexture road_reflection;           // drawn before the passes where the view reads it
-  TargetTexture road_reflection_depth;
-  GLuint spray_layer_fbo = 0;
-  TargetTexture spray_layer;
+  // Each transient (the glass layer, the road reflection, the spray layer) once the pass that
+  // writes it has begun; empty before.
+  std::array<FrameTarget, kResourceCount> transients{};
+  const FrameTarget& transient(Resource r) const { return transients[static_cast<std::size_t>(r)]; }
 };
 
 // Resources made once and shared by the passes.
@@ -80,6 +87,9 @@ struct SharedResources {
   int horizon_directions = 0;
   std::shared_ptr<const relief::RoadReliefs> reliefs;
 };
+
+// The shared resources made and bound to their units (shared_resources.cpp). Render thread.
+std::unique_ptr<SharedResources> make_shared_resources();
 
 // Axis-aligned box against the view frustum's side and near planes.
 bool box_visible(const glm::mat4& view_proj, const glm::vec3& lo, const glm::vec3& hi);

@@ -7,7 +7,6 @@
 #include <glm/geometric.hpp>
 
 #include "server/render/cpu/shader_interface.hpp"
-#include "server/render/gl/render_state.hpp"
 
 namespace downpour::render {
 
@@ -45,6 +44,9 @@ LampMap::LampMap()
     if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
       throw std::runtime_error("lamp map framebuffer incomplete");
   }
+  // Dark until first drawn (a view that reads it unweighted reads 0, never what the memory held).
+  const float black[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  glClearTexImage(texture_.id(), 0, GL_RGBA, GL_FLOAT, black);
 }
 
 void LampMap::draw(const std::vector<glm::vec4>& ground_boxes) {
@@ -53,8 +55,6 @@ void LampMap::draw(const std::vector<glm::vec4>& ground_boxes) {
   program_.use();
   const auto count = static_cast<GLsizei>(std::min<std::size_t>(ground_boxes.size(), kMaxLamps));
   if (count > 0) u_boxes_.set(ground_boxes.data(), count);
-  // Added up (premultiplied blending of a colour whose alpha is 0).
-  apply(RenderState{DepthTest::kOff, false, Blend::kPremultiplied});
   glViewport(0, 0, LampRings::kCells, LampRings::kCells);
   glBindVertexArray(vao_.id());
   const float black[4] = {0.0f, 0.0f, 0.0f, 0.0f};

@@ -40,8 +40,8 @@ class LampMap {
  public:
   LampMap();
   // Draws the lamps' light into the rings, each lamp over its box on the ground (x0, y0, x1, y1;
-  // PackedLamps::ground_boxes), added up; the frame block (lamp_map, lamp_rings) and the lamp
-  // block must be uploaded. Binds the map to its texture unit.
+  // PackedLamps::ground_boxes), added up (its pass's state: lamp_map_pass.hpp); the frame block
+  // (lamp_map, lamp_rings) and the lamp block must be uploaded. Binds the map to its texture unit.
   void draw(const std::vector<glm::vec4>& ground_boxes);
   GLuint texture() const { return texture_.id(); }
 

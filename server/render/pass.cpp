@@ -1,6 +1,7 @@
 #include "server/render/pass.hpp"
 
 #include <algorithm>
+#include <array>
 #include <iterator>
 #include <stdexcept>
 
@@ -10,16 +11,32 @@ namespace downpour::render {
 
 namespace {
 
+constexpr std::array<float, 4> kClear{0.0f, 0.0f, 0.0f, 0.0f};
+constexpr std::array<float, 4> kBlack{0.0f, 0.0f, 0.0f, 1.0f};
+
 constexpr ResourceInfo kResources[] = {
-    {Resource::kViewColour, "view colour", texture_unit::kViewColour, false, true},
-    {Resource::kViewDepth, "view depth", texture_unit::kViewDepth, false, true},
-    {Resource::kGlassLayer, "glass layer", texture_unit::kGlassLayer, false, false},
-    // (Three texture buffers at their own units: upload_glass_surface.)
-    {Resource::kGlassSurface, "glass water surface", 0, true, false},
-    {Resource::kEnvironment, "environment", texture_unit::kEnvironment, true, false},
-    {Resource::kRoadWater, "road water", texture_unit::kRoadWater, true, false},
-    {Resource::kRoadReflection, "road reflection", texture_unit::kReflection, true, false},
-    {Resource::kSprayLayer, "spray layer", texture_unit::kSprayLayer, false, false},
+    {Resource::kViewColour, "view colour", texture_unit::kViewColour, false, true, kNotTransient,
+     false, kClear, 0.0f},
+    {Resource::kViewDepth, "view depth", texture_unit::kViewDepth, false, true, kNotTransient,
+     false, kClear, 0.0f},
+    // Its depth: the nearest water (1, reversed-Z), for the mask.
+    {Resource::kGlassLayer, "glass layer", texture_unit::kGlassLayer, false, false, kGlassLayerSize,
+     true, kClear, 1.0f},
+    // (Three texture buffers at their own units: RenderSession::Impl::upload_glass_surface.)
+    {Resource::kGlassSurface, "glass water surface", 0, true, false, kNotTransient, false, kClear,
+     0.0f},
+    {Resource::kEnvironment, "environment", texture_unit::kEnvironment, true, false, kNotTransient,
+     false, kClear, 0.0f},
+    {Resource::kRoadWater, "road water", texture_unit::kRoadWater, true, false, kNotTransient,
+     false, kClear, 0.0f},
+    // Its depth: the far plane (0, reversed-Z), as a view's.
+    {Resource::kRoadReflection, "road reflection", texture_unit::kReflection, true, false,
+     kRoadReflectionScale, true, kBlack, 0.0f},
+    {Resource::kSprayLayer, "spray layer", texture_unit::kSprayLayer, false, false,
+     kSprayLayerScale, false, kClear, 0.0f},
+    // (Its two rings are the lamp map's own targets.)
+    {Resource::kLampMap, "lamp map", texture_unit::kLampMap, true, false, kNotTransient, false,
+     kClear, 0.0f},
 };
 static_assert(std::size(kResources) == kResourceCount);
 constexpr bool in_order() {
@@ -62,6 +79,19 @@ void check_pass_order(std::string_view view, const std::vector<Pass*>& passes) {
       if (resource_info(r).from_frame) fail(d, "cannot write", r);
       available.push_back(r);
     }
+  }
+}
+
+void check_frame_pass(const Pass& pass) {
+  const PassDecl& d = pass.decl();
+  auto fail = [&](std::string_view what) {
+    throw std::logic_error("frame pass " + d.name + ": " + std::string(what));
+  };
+  if (d.writes.size() != 1 || !resource_info(d.writes.front()).from_frame)
+    fail("must write one resource of the frame's start");
+  for (Resource r : d.reads) {
+    if (!resource_info(r).from_frame || r == d.writes.front())
+      fail("reads " + std::string(resource_name(r)) + ", which is not there before it");
   }
 }
 

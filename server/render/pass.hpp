@@ -12,44 +12,24 @@
 
 #include "server/render/frame_context.hpp"
 #include "server/render/gl/render_state.hpp"
+#include "server/render/resource.hpp"
 
 namespace downpour::render {
 
-enum class Resource : std::uint8_t {
-  kViewColour,  // the view's colour target: cleared at the frame's start
-  kViewDepth,   // its depth (reversed-Z): cleared at the frame's start
-  kGlassLayer,  // the water on the glass over the scene, reduced size, premultiplied
-  // The water's surface on the glass (sim::GlassWaterSurface), uploaded from the simulation on
-  // first read.
-  kGlassSurface,
-  // The world outside the windshield as a cube map (environment_probe.hpp), the session's, which
-  // the renderer refreshes before the view's passes where one reads it.
-  kEnvironment,
-  kRoadWater,  // the road's water around the car, uploaded from the simulation on first read
-  // The scene mirrored in the road's plane with its depth, a quarter of the view: the renderer
-  // draws it before the view's passes where one reads it and the road is wet.
-  kRoadReflection,
-  kSprayLayer,  // the spray over the scene, half the view, premultiplied
-};
-inline constexpr std::size_t kResourceCount = 8;
-
-// What the renderer knows of each resource, in one table (pass.cpp).
-struct ResourceInfo {
-  Resource resource;
+// One step of a pass that draws under more than one state: its name and state.
+struct PassStep {
   std::string_view name;
-  unsigned texture_unit;  // where a pass that reads it finds it (shader_interface.hpp)
-  bool from_frame;        // there from the frame's start (the simulation's, or drawn before)
-  bool view_target;       // the view's own colour or depth
+  RenderState state;
 };
-const ResourceInfo& resource_info(Resource resource);
-inline std::string_view resource_name(Resource resource) { return resource_info(resource).name; }
 
 struct PassDecl {
   std::string name;
   std::vector<Resource> reads;   // bound to their texture units before the pass runs
   std::vector<Resource> writes;  // one target: the view (colour and/or depth), or a transient
-  RenderState state;
-  bool reads_step = false;  // calls FrameContext::water() or rain(): the state after the step
+  RenderState state;             // applied before the pass runs
+  bool reads_step = false;       // calls FrameContext::water() or rain(): the state after the step
+  // Every other state the pass draws under, in the order it draws them (Pass::apply_step).
+  std::vector<PassStep> steps = {};
 };
 
 class Pass {
@@ -59,10 +39,19 @@ class Pass {
   // Nothing to draw this frame (clear glass) skips the pass and its target's preparation.
   virtual bool wanted(const FrameContext&) const { return true; }
   virtual void execute(const FrameContext& frame, const FrameResources& resources) = 0;
+
+ protected:
+  // Applies the declared state of step `i` (PassDecl::steps); the pass's own state is `state`.
+  void apply_step(std::size_t i) const { apply(decl().steps.at(i).state); }
+  void apply_own_state() const { apply(decl().state); }
 };
 
 // Throws std::logic_error naming the pass and the resource where a pass of `view` reads what
-// neither the frame's start nor an earlier pass provides, or writes more than one target.
+// neither the frame's start nor an earlier pass provides, or writes more than one target, or
+// writes what the frame's start provides.
 void check_pass_order(std::string_view view, const std::vector<Pass*>& passes);
+// Likewise for a frame pass: one that draws a resource of the frame's start (from_frame) before
+// the view's passes, reading nothing but the frame's start.
+void check_frame_pass(const Pass& pass);
 
 }  // namespace downpour::render

@@ -64,7 +64,8 @@ void GlassWaterPass::execute(const FrameContext& frame, const FrameResources& re
   o.view_pixel_rad.set(2.0f * static_cast<float>(frame.camera.tan_half_fov_y) /
                        static_cast<float>(std::max(frame.spec.height, 1)));
   o.samples.set(samples);
-  o.inv_target.set(1.0f / glm::vec2(resources.glass_layer.width, resources.glass_layer.height));
+  const TargetTexture& layer = resources.transient(Resource::kGlassLayer).colour;
+  o.inv_target.set(1.0f / glm::vec2(layer.width, layer.height));
   o.quad.draw(frame);  // also the glass's axes, for the rays' frame
 }
 

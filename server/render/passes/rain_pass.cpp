@@ -156,21 +156,16 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, storage_buffer::kRunsBuffer, buffer.id());
   program_.use();
   glBindVertexArray(vao_.id());
-  // The tiles clear of the cabin (all of them but in the driver's views) need no depth test: the
-  // rain there lies beyond anything drawn nearer than the glass. On llvmpipe the test costs about a
-  // quarter of the composite.
+  // The tiles clear of the cabin (all of them but in the driver's views), then those the cabin
+  // reaches into (decl_'s steps).
   const auto clear = static_cast<GLsizei>(layer.clear_runs());
-  glDisable(GL_DEPTH_TEST);
+  apply_step(kClearTiles);
   if (clear > 0) glDrawArrays(GL_TRIANGLES, 0, 6 * clear);
-  glEnable(GL_DEPTH_TEST);  // the pass's own state again (decl_)
   const auto edge = static_cast<GLsizei>(runs_uv_.size()) - clear;
   if (edge == 0) return;
-  // The tiles the cabin reaches into: the rain at the windshield's depth, so that the depth test
-  // leaves out the cabin (nearer than the glass).
   u_plane_depth_.set(frame.glass.depth_over_image());
-  glEnable(GL_DEPTH_CLAMP);
+  apply_step(kCabinTiles);
   glDrawArrays(GL_TRIANGLES, 6 * clear, 6 * edge);
-  glDisable(GL_DEPTH_CLAMP);
 }
 
 RainPass::Sized& RainPass::sized(int width, int height) {

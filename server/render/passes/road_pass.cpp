@@ -64,7 +64,7 @@ float RoadPass::relief_reach_m(const FrameContext& frame) {
 void RoadPass::execute(const FrameContext& frame, const FrameResources& resources) {
   // The mirror where the renderer drew the reflection (a film stands somewhere); ripples where,
   // besides, it rains on a puddle.
-  const bool mirror = resources.road_reflection.texture != 0;
+  const bool mirror = resources.transient(Resource::kRoadReflection).colour.texture != 0;
   const sim::RoadWaterImage* water = frame.scene.road_water.get();
   const bool ripples = mirror && frame.scene.weather.rain_rate_mm_h > 0.0 && water &&
                        water->max_standing_mm > kPuddleFromMm;
@@ -84,7 +84,6 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
   drew_relief_ = relief_ && (std::max({sun.r, sun.g, sun.b}) > kReliefSunFrom || beams);
   const std::size_t plain = ripples ? 2 : mirror ? 1 : 0;
   const glm::mat4 view_proj = frame.camera.projection * frame.camera.view;
-  glEnable(GL_CLIP_DISTANCE1);
   // Relief shadows: the near road with them, the rest without (llvmpipe would fetch the horizon
   // maps on every pixel of one draw, even where a branch skips them). Where a pixel covers many
   // of the relief's texels the shader takes their shadows' mean; the near part ends where that
@@ -103,7 +102,6 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
   mean_lit_[plain].set(mean_lit);
   near_split_[plain].set(glm::vec2(drew_relief_ ? reach : 0.0f, -1.0f));
   frame.world->road.draw_visible(view_proj, frame.camera.position);
-  glDisable(GL_CLIP_DISTANCE1);
 }
 
 }  // namespace downpour::render

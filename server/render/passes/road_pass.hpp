@@ -27,10 +27,12 @@ class RoadPass final : public Pass {
   static float relief_reach_m(const FrameContext& frame);
 
  private:
+  // (gl_ClipDistance[1]: the split between the near road, drawn with relief shadows, and the rest;
+  // mesh_vertex.glsl.)
   const PassDecl decl_{"road",
-                       {Resource::kRoadWater, Resource::kRoadReflection},
+                       {Resource::kRoadWater, Resource::kRoadReflection, Resource::kLampMap},
                        {Resource::kViewColour, Resource::kViewDepth},
-                       {DepthTest::kNearer, true, Blend::kOff}};
+                       {DepthTest::kNearer, true, Blend::kOff, true, false, 0b10}};
   // road.frag, road_mirror.frag, road_ripples.frag, then the same with relief shadows
   // (road_surface.glsl): llvmpipe pays for both sides of a branch on every pixel, so the mirror,
   // the ripples and the shadows are programs of their own.

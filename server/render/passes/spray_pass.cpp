@@ -208,8 +208,8 @@ void SprayPass::depth_maps(const FrameContext& frame, Targets& t) {
   glViewport(0, 0, t.width, t.height);
   const float far[4] = {kFar, kFar, kFar, kFar};
   const float no_hit = 0.0f;
-  // (A depth clear obeys the depth mask: writes on first.)
-  apply(RenderState{DepthTest::kNearer, true, Blend::kOff});
+  // (A depth clear obeys the depth mask: the step writes depth.)
+  apply_step(kMaps);
   glClearNamedFramebufferfv(t.depth_fbo.id(), GL_COLOR, 0, far);
   glClearNamedFramebufferfv(t.depth_fbo.id(), GL_DEPTH, 0, &no_hit);
   // The spray's parcels first, then the body's: each hit leaves its kind in the mask and passes a
@@ -225,12 +225,8 @@ void SprayPass::depth_maps(const FrameContext& frame, Targets& t) {
   u_depth_projection_.set(frame.camera.projection);
   u_depth_spray_.set(static_cast<int>(spray_.size()));
   u_depth_near_.set(frame.camera.near_m);
-  glDepthFunc(GL_GEQUAL);
-  glEnable(GL_BLEND);
-  glBlendEquation(GL_MIN);
   glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, static_cast<GLsizei>(packed_.size()));
-  glBlendEquation(GL_FUNC_ADD);
-  apply(decl_.state);
+  apply_own_state();
 }
 
 // The clouds' optical depth, and times distance, at a quarter of the view.
@@ -255,10 +251,9 @@ void SprayPass::haze_map(const FrameContext& frame, Targets& t) {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, storage_buffer::kHazeBuffer, haze_.id());
   haze_program_.use();
   u_haze_projection_.set(frame.camera.projection);
-  glEnable(GL_BLEND);
-  glBlendFunc(GL_ONE, GL_ONE);
+  apply_step(kHaze);
   glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, static_cast<GLsizei>(clouds_.size()));
-  apply(decl_.state);
+  apply_own_state();
 }
 
 GLuint SprayPass::smooth(Targets& t, const std::vector<glm::vec4>& runs, glm::vec2 tan) {
@@ -286,15 +281,14 @@ GLuint SprayPass::smooth(Targets& t, const std::vector<glm::vec4>& runs, glm::ve
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, storage_buffer::kRunsBuffer, runs_buffer_.id());
   glViewport(0, 0, t.width, t.height);
   // Only where the mask holds the body (llvmpipe rejects the rest before shading).
-  apply(RenderState{DepthTest::kNearer, false, Blend::kOff});
-  glDepthFunc(GL_LESS);
+  apply_step(kSmooth);
   for (int pass = 0; pass < passes; ++pass) {
     glBindTextureUnit(texture_unit::kSpraySmooth, body_front);
     glBindFramebuffer(GL_FRAMEBUFFER, t.smooth_fbo[pass % 2].id());
     glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(6 * runs.size()));
     body_front = t.smooth[pass % 2].id();
   }
-  apply(decl_.state);
+  apply_own_state();
   return body_front;
 }
 
@@ -436,14 +430,13 @@ void SprayPass::execute(const FrameContext& frame, const FrameResources& resourc
     glBindTextureUnit(texture_unit::kSpraySmooth, body_front);
     // (Attached each frame: the renderer may have replaced the layer's texture under the same
     // name.)
-    glNamedFramebufferTexture(t.shade_fbo.id(), GL_COLOR_ATTACHMENT0, resources.spray_layer.texture,
-                              0);
+    glNamedFramebufferTexture(t.shade_fbo.id(), GL_COLOR_ATTACHMENT0,
+                              resources.transient(Resource::kSprayLayer).colour.texture, 0);
     glBindFramebuffer(GL_FRAMEBUFFER, t.shade_fbo.id());
     glViewport(0, 0, width, height);
     // The runs at depth 0 pass only where a hit left more (llvmpipe rejects the rest before
     // shading them).
-    apply(RenderState{DepthTest::kNearer, false, Blend::kOff});
-    glDepthFunc(GL_LESS);
+    apply_step(kShade);
     shade_program_.use();
     u_shade_size_.set(size);
     u_shade_tan_.set(tan);
@@ -452,7 +445,7 @@ void SprayPass::execute(const FrameContext& frame, const FrameResources& resourc
     u_shade_scale_.set(kScale);
     u_shade_absorption_.set(kAbsorption);
     draw_runs(liquid_runs_);
-    apply(decl_.state);
+    apply_own_state();
   }
 
   if (!clouds_.empty()) {
@@ -462,16 +455,16 @@ void SprayPass::execute(const FrameContext& frame, const FrameResources& resourc
     // (Linear: the shader adds the lamps' light where their beams pass, then encodes it.)
     const glm::vec3 light =
         glm::mix(atm.sky_horizon, atm.ambient, 0.4f) * 0.95f + atm.sun_radiance * 0.05f;
-    glBindFramebuffer(GL_FRAMEBUFFER, resources.spray_layer_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, resources.transient(Resource::kSprayLayer).fbo);
     glViewport(0, 0, width, height);
     glBindTextureUnit(texture_unit::kSprayHaze, t.haze.id());
     haze_composite_program_.use();
     u_haze_light_.set(light);
     u_haze_near_.set(camera.near_m);
     u_haze_soft_.set(kHazeSoftM);
-    apply(RenderState{DepthTest::kOff, false, Blend::kPremultiplied});
+    apply_step(kHazeOver);
     draw_runs(all_runs_);
-    apply(decl_.state);
+    apply_own_state();
   }
 }
 

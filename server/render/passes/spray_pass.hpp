@@ -31,9 +31,9 @@ class SprayPass final : public Pass {
   bool wanted(const FrameContext& frame) const override;
   void execute(const FrameContext& frame, const FrameResources& resources) override;
 
-  static constexpr int kScale = 3;      // the layer's size: the view's over this, each way
-  static constexpr int kHazeScale = 2;  // the haze's: the layer's over this
-  static constexpr int kTile = 8;       // the layer's tiles, pixels
+  static constexpr int kScale = kSprayLayerScale;  // the layer's size: the view's over this
+  static constexpr int kHazeScale = 2;             // the haze's: the layer's over this
+  static constexpr int kTile = 8;                  // the layer's tiles, pixels
 
   // Makes the targets and CPU buffers a view of this size will need.
   void prepare(int view_width, int view_height);
@@ -55,10 +55,21 @@ class SprayPass final : public Pass {
                                        const std::vector<float>& front);
 
  private:
+  // Its steps: the depth maps (a sphere's hit passes greater-or-equal, so that MIN blending keeps
+  // the nearest front and the farthest back), the smoothing and the shading (each only where the
+  // mask holds a hit: kFarther at a depth under the mask's), the haze's optical depth (added up),
+  // and the haze over the layer.
+  enum Step : std::size_t { kMaps, kSmooth, kShade, kHaze, kHazeOver };
   const PassDecl decl_{"spray",
                        {Resource::kViewColour, Resource::kViewDepth},
                        {Resource::kSprayLayer},
-                       {DepthTest::kOff, false, Blend::kOff}};
+                       {DepthTest::kOff, false, Blend::kOff},
+                       false,
+                       {{"maps", {DepthTest::kNearerOrEqual, true, Blend::kMin}},
+                        {"smooth", {DepthTest::kFarther, false, Blend::kOff}},
+                        {"shade", {DepthTest::kFarther, false, Blend::kOff}},
+                        {"haze", {DepthTest::kOff, false, Blend::kAdd}},
+                        {"haze over", {DepthTest::kOff, false, Blend::kPremultiplied}}}};
   struct Targets {
     int width = 0, height = 0;
     Texture depth;  // RGBA32F, the four maps

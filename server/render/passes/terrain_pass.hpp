@@ -14,7 +14,7 @@ class TerrainPass final : public Pass {
 
  private:
   const PassDecl decl_{"terrain",
-                       {},
+                       {Resource::kLampMap},
                        {Resource::kViewColour, Resource::kViewDepth},
                        {DepthTest::kNearer, true, Blend::kOff}};
   ShaderProgram program_;

@@ -19,7 +19,7 @@ class VehiclePass final : public Pass {
                bool flash_on);
 
   const PassDecl decl_{"vehicles",
-                       {},
+                       {Resource::kLampMap},
                        {Resource::kViewColour, Resource::kViewDepth},
                        {DepthTest::kNearer, true, Blend::kOff}};
   ShaderProgram program_;

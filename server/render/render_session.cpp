@@ -1,0 +1,81 @@
+#include "server/render/render_session.hpp"
+
+#include <algorithm>
+#include <utility>
+
+#include "server/render/cpu/shader_interface.hpp"
+
+namespace downpour::render {
+
+RenderSession::RenderSession(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+RenderSession::~RenderSession() = default;
+
+void RenderSession::Impl::upload_glass_surface(
+    std::shared_ptr<const sim::GlassWaterSurface> surface) {
+  // No water (the blades alone): an empty grid, which the optics find dry everywhere.
+  static const auto dry = std::make_shared<const sim::GlassWaterSurface>();
+  if (!surface) surface = dry;
+  if (surface_shown != surface) {
+    const std::array<std::pair<const void*, std::size_t>, 3> parts{{
+        {surface->bodies.data(), surface->bodies.size() * sizeof(sim::WaterBody)},
+        {surface->cells.data(), surface->cells.size() * sizeof(std::uint32_t)},
+        {surface->entries.data(), surface->entries.size() * sizeof(std::uint32_t)},
+    }};
+    constexpr GLenum kFormats[3] = {GL_RGBA32F, GL_R32UI, GL_R32UI};
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      // Grown as needed (never empty: a texture buffer needs storage), else refilled.
+      const std::size_t bytes = std::max<std::size_t>(parts[k].second, 16);
+      if (!glass_surface[k].id() || glass_surface_bytes[k] < bytes) {
+        GLuint id = 0;
+        glCreateBuffers(1, &id);
+        glass_surface[k] = Buffer(id);
+        glass_surface_bytes[k] = std::max(bytes, 2 * glass_surface_bytes[k]);
+        glNamedBufferStorage(id, static_cast<GLsizeiptr>(glass_surface_bytes[k]), nullptr,
+                             GL_DYNAMIC_STORAGE_BIT);
+        GLuint tex = 0;
+        glCreateTextures(GL_TEXTURE_BUFFER, 1, &tex);
+        glass_surface_tex[k] = Texture(tex);
+        glTextureBuffer(tex, kFormats[k], id);
+      }
+      if (parts[k].second > 0)
+        glNamedBufferSubData(glass_surface[k].id(), 0, static_cast<GLsizeiptr>(parts[k].second),
+                             parts[k].first);
+    }
+    surface_shown = surface;
+  }
+  const GLuint units[3] = {texture_unit::kGlassBodies, texture_unit::kGlassCells,
+                           texture_unit::kGlassEntries};
+  for (std::size_t k = 0; k < 3; ++k) glBindTextureUnit(units[k], glass_surface_tex[k].id());
+}
+
+void RenderSession::Impl::upload_road_water(
+    const std::shared_ptr<const sim::RoadWaterImage>& image) {
+  const bool valid = image && image->complete();
+  const int n = valid ? image->cells : 1, rings = valid ? image->levels : 1;
+  if (!road_water.id() || road_cells != n || road_rings != rings) {
+    road_water = make_texture_2d_array(GL_RG16F, n, n, rings);
+    glTextureParameteri(road_water.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(road_water.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    road_cells = n;
+    road_rings = rings;
+    road_shown.reset();
+    road_dry_shown = false;
+  }
+  if (!valid) {
+    if (!road_dry_shown) {
+      const float dry[2] = {0.0f, 0.0f};
+      glTextureSubImage3D(road_water.id(), 0, 0, 0, 0, 1, 1, 1, GL_RG, GL_FLOAT, dry);
+      road_dry_shown = true;
+      road_shown.reset();
+    }
+    return;
+  }
+  if (road_shown == image) return;
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureSubImage3D(road_water.id(), 0, 0, 0, 0, n, n, rings, GL_RG, GL_FLOAT,
+                      image->water_standing_mm.data());
+  road_shown = image;
+  road_dry_shown = false;
+}
+
+}  // namespace downpour::render

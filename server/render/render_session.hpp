@@ -1,0 +1,44 @@
+// What the renderer keeps per session (RenderSession::Impl, renderer.hpp): each view's targets, the
+// world outside its glass, and the simulation's state on the GPU as the session's frames last
+// showed it (the water's surface on the glass, the road's water), uploaded only when it changes.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "server/render/environment_probe.hpp"
+#include "server/render/gl/gl_objects.hpp"
+#include "server/render/render_targets.hpp"
+#include "server/render/renderer.hpp"
+#include "server/sim/glass_water_surface.hpp"
+#include "server/sim/road_water.hpp"
+
+namespace downpour::render {
+
+struct RenderSession::Impl {
+  std::vector<std::unique_ptr<ViewTarget>> views;
+  // The water's surface on the glass (bodies, cells, entries: buffers, read as texture buffers) and
+  // what it holds.
+  std::array<Buffer, 3> glass_surface;
+  std::array<Texture, 3> glass_surface_tex;
+  std::array<std::size_t, 3> glass_surface_bytes{};
+  std::shared_ptr<const sim::GlassWaterSurface> surface_shown;
+  // The world outside the glass, shared by the session's views (made on first use).
+  std::unique_ptr<EnvironmentProbe> environment;
+  // The road's water window on the GPU and the image it shows (held, so that its address names it).
+  Texture road_water;
+  int road_cells = 0, road_rings = 0;
+  std::shared_ptr<const sim::RoadWaterImage> road_shown;
+  bool road_dry_shown = false;
+
+  // The water surface on the glass brought up to the frame's (a whole upload for each new one:
+  // the step publishes one per tick), bound to its texture buffers.
+  void upload_glass_surface(std::shared_ptr<const sim::GlassWaterSurface> surface);
+  // The road water rings brought up to the frame's: a whole upload for each new image (one per
+  // road step: 4 rings of 64 x 64 cells, two half floats each).
+  void upload_road_water(const std::shared_ptr<const sim::RoadWaterImage>& image);
+};
+
+}  // namespace downpour::render

@@ -1,0 +1,78 @@
+#include "server/render/render_targets.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <utility>
+
+namespace downpour::render {
+
+Framebuffer framebuffer_with(GLuint colour, GLuint depth) {
+  GLuint fb = 0;
+  glCreateFramebuffers(1, &fb);
+  Framebuffer fbo(fb);
+  if (colour) glNamedFramebufferTexture(fb, GL_COLOR_ATTACHMENT0, colour, 0);
+  if (depth) glNamedFramebufferTexture(fb, GL_DEPTH_ATTACHMENT, depth, 0);
+  if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    throw std::runtime_error("render target framebuffer incomplete");
+  }
+  return fbo;
+}
+
+ViewTarget::ViewTarget(int w, int h) : width(w), height(h) {
+  colour = make_texture_2d(GL_RGBA8, w, h);
+  depth = make_texture_2d(GL_DEPTH_COMPONENT32F, w, h);
+  fbo = framebuffer_with(colour.id(), depth.id());
+  GLuint ids[kReadbackSlots];
+  glCreateBuffers(kReadbackSlots, ids);
+  for (int i = 0; i < kReadbackSlots; ++i) {
+    pbo[i] = Buffer(ids[i]);
+    glNamedBufferStorage(ids[i], static_cast<GLsizeiptr>(w) * h * 4, nullptr, GL_MAP_READ_BIT);
+  }
+}
+
+ViewTarget::~ViewTarget() {
+  for (GLsync f : fence) {
+    if (f) glDeleteSync(f);
+  }
+}
+
+bool ViewTarget::busy() const {
+  return std::any_of(fence.begin(), fence.end(), [](GLsync f) { return f != nullptr; });
+}
+
+Transient& TransientTargets::get(Resource r, int width, int height, std::uint64_t frame) {
+  const auto key = std::make_tuple(r, width, height);
+  auto it = targets_.find(key);
+  if (it != targets_.end()) {
+    it->second.last_frame = frame;
+    return it->second;
+  }
+  Transient t;
+  t.last_frame = frame;
+  t.width = width;
+  t.height = height;
+  t.texture = make_texture_2d(GL_RGBA8, width, height);
+  if (resource_info(r).depth) {
+    t.depth = make_texture_2d(GL_DEPTH_COMPONENT32F, width, height);
+    glTextureParameteri(t.depth.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(t.depth.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(t.depth.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(t.depth.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  }
+  glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  t.fbo = framebuffer_with(t.texture.id(), t.depth.id());
+  return targets_.emplace(key, std::move(t)).first->second;
+}
+
+void TransientTargets::evict() {
+  while (targets_.size() > kMax) {
+    auto oldest = targets_.begin();
+    for (auto it = targets_.begin(); it != targets_.end(); ++it) {
+      if (it->second.last_frame < oldest->second.last_frame) oldest = it;
+    }
+    targets_.erase(oldest);
+  }
+}
+
+}  // namespace downpour::render

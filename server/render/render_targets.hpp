@@ -1,0 +1,64 @@
+// The renderer's GL targets: each view's colour, depth and readback buffers (ViewTarget), and the
+// targets that live within a frame (the glass layer, the spray layer, the road reflection), made
+// as the resource table says (pass.hpp's ResourceInfo) and kept by size (TransientTargets).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <tuple>
+
+#include "server/render/gl/gl_objects.hpp"
+#include "server/render/pass.hpp"
+
+namespace downpour::render {
+
+inline constexpr int kReadbackSlots = 2;
+
+// A framebuffer with these attachments (0: none); throws if GL finds it incomplete.
+Framebuffer framebuffer_with(GLuint colour, GLuint depth);
+
+// A view's colour and depth, and its readback buffers.
+struct ViewTarget {
+  int width = 0;
+  int height = 0;
+  Texture colour;
+  Texture depth;
+  Framebuffer fbo;
+  std::array<Buffer, kReadbackSlots> pbo;
+  std::array<GLsync, kReadbackSlots> fence{};  // a readback in flight per slot
+  int next_slot = 0;
+
+  ViewTarget(int w, int h);
+  ~ViewTarget();
+  ViewTarget(const ViewTarget&) = delete;
+  ViewTarget& operator=(const ViewTarget&) = delete;
+  bool busy() const;
+};
+
+// A target that lives only within a frame.
+struct Transient {
+  Texture texture;
+  Texture depth;  // where its resource has one (ResourceInfo::depth)
+  Framebuffer fbo;
+  int width = 0;
+  int height = 0;
+  std::uint64_t last_frame = 0;  // the last frame that drew into it
+};
+
+class TransientTargets {
+ public:
+  // The target for `r` at this size, made on first use, marked as drawn in `frame`.
+  Transient& get(Resource r, int width, int height, std::uint64_t frame);
+  // Many view sizes at once are rare: past kMax, the targets unused the longest go. Call it at a
+  // frame's start, so that it never takes one a pass of the frame has bound.
+  void evict();
+  void clear() { targets_.clear(); }
+
+ private:
+  static constexpr std::size_t kMax = 12;
+  std::map<std::tuple<Resource, int, int>, Transient> targets_;
+};
+
+}  // namespace downpour::render

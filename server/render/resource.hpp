@@ -1,0 +1,61 @@
+// The resources a frame's passes read and write (pass.hpp), and what the renderer knows of each, in
+// one table (pass.cpp): where a pass finds it, whether the frame's start provides it, and how the
+// renderer makes it where it is a transient.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+namespace downpour::render {
+
+enum class Resource : std::uint8_t {
+  kViewColour,  // the view's colour target: cleared at the frame's start
+  kViewDepth,   // its depth (reversed-Z): cleared at the frame's start
+  kGlassLayer,  // the water on the glass over the scene, reduced size, premultiplied
+  // The water's surface on the glass (sim::GlassWaterSurface), uploaded from the simulation on
+  // first read.
+  kGlassSurface,
+  // The world outside the windshield as a cube map (environment_probe.hpp), the session's, which
+  // the renderer refreshes before the view's passes where one reads it.
+  kEnvironment,
+  kRoadWater,  // the road's water around the car, uploaded from the simulation on first read
+  // The scene mirrored in the road's plane with its depth, a quarter of the view: drawn by a frame
+  // pass (road_reflection_pass.hpp) before the view's passes where one reads it and the road is
+  // wet.
+  kRoadReflection,
+  kSprayLayer,  // the spray over the scene, a third of the view, premultiplied
+  // The lamps' light on the ground around the camera (lamp_map.hpp): drawn by a frame pass
+  // (lamp_map_pass.hpp) where the frame has lamps; read weighted by the frame block's lamp_map.x,
+  // which is 0 where it was not drawn.
+  kLampMap,
+};
+inline constexpr std::size_t kResourceCount = 9;
+
+// What the renderer knows of each resource, in one table (pass.cpp).
+struct ResourceInfo {
+  Resource resource;
+  std::string_view name;
+  unsigned texture_unit;  // where a pass that reads it finds it (shader_interface.hpp)
+  // There from the frame's start: the simulation's, uploaded on first read, or drawn by a frame
+  // pass before the view's passes. Only a frame pass writes one.
+  bool from_frame;
+  bool view_target;  // the view's own colour or depth
+  // A transient, made by the renderer for the pass that writes it and kept by size
+  // (render_targets.hpp): its size is the view's over `scale` each way, or the glass layer's own
+  // (GlassView::layer_size) for kGlassLayerSize; kNotTransient for the rest.
+  int scale;
+  bool depth;  // a transient with a depth attachment of its own
+  // What a transient holds before the first pass of a frame draws into it.
+  std::array<float, 4> clear_colour;
+  float clear_depth;
+};
+inline constexpr int kNotTransient = -1;
+inline constexpr int kGlassLayerSize = 0;
+inline constexpr int kSprayLayerScale = 3;      // the spray layer: a third of the view each way
+inline constexpr int kRoadReflectionScale = 4;  // the road reflection: a quarter
+const ResourceInfo& resource_info(Resource resource);
+inline std::string_view resource_name(Resource resource) { return resource_info(resource).name; }
+
+}  // namespace downpour::render

@@ -1,0 +1,87 @@
+#include "server/render/view_passes.hpp"
+
+#include <utility>
+
+#include "server/render/passes/cockpit_pass.hpp"
+#include "server/render/passes/environment_background_pass.hpp"
+#include "server/render/passes/glass_composite_pass.hpp"
+#include "server/render/passes/glass_water_mask_pass.hpp"
+#include "server/render/passes/glass_water_pass.hpp"
+#include "server/render/passes/lamp_glow_pass.hpp"
+#include "server/render/passes/lamp_map_pass.hpp"
+#include "server/render/passes/rain_pass.hpp"
+#include "server/render/passes/road_pass.hpp"
+#include "server/render/passes/road_reflection_pass.hpp"
+#include "server/render/passes/sky_pass.hpp"
+#include "server/render/passes/spray_pass.hpp"
+#include "server/render/passes/street_light_pass.hpp"
+#include "server/render/passes/terrain_pass.hpp"
+#include "server/render/passes/vehicle_pass.hpp"
+#include "server/render/passes/windshield_pass.hpp"
+
+namespace downpour::render {
+
+ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
+                            const FrameLamps& lamps, SpraySmoothing smoothing) {
+  ViewPasses p;
+  auto own = [&p](auto pass) {
+    auto* raw = pass.get();
+    p.owned.push_back(std::move(pass));
+    return raw;
+  };
+  Pass* cockpit = own(std::make_unique<CockpitPass>(shared));
+  Pass* vehicles = own(std::make_unique<VehiclePass>(shared));
+  Pass* street_lights = own(std::make_unique<StreetLightPass>(shared));
+  p.road = own(std::make_unique<RoadPass>(shared));
+  Pass* road = p.road;
+  Pass* terrain = own(std::make_unique<TerrainPass>(shared));
+  Pass* sky = own(std::make_unique<SkyPass>(shared));
+  Pass* glow = own(std::make_unique<LampGlowPass>(shared));
+  p.rain = own(std::make_unique<RainPass>(shared));
+  Pass* rain = p.rain;
+  Pass* rain_mask = own(std::make_unique<RainMaskPass>(shared));
+  Pass* environment_background = own(std::make_unique<EnvironmentBackgroundPass>(shared));
+  GlassWaterPass* glass_water = own(std::make_unique<GlassWaterPass>(shared));
+  Pass* glass_water_mask = own(std::make_unique<GlassWaterMaskPass>(shared, *glass_water));
+  Pass* glass_composite = own(std::make_unique<GlassCompositePass>(shared));
+  Pass* windshield = own(std::make_unique<WindshieldPass>(shared));
+  p.spray = own(std::make_unique<SprayPass>(shared));
+  p.spray->set_smoothing(smoothing);
+  Pass* spray = p.spray;
+  Pass* spray_composite = own(std::make_unique<SprayCompositePass>(shared, *p.spray));
+  p.lamp_map = own(std::make_unique<LampMapPass>(lamps));
+  // What the road's mirror shows, each clipped this far above the road's plane.
+  p.reflection = own(std::make_unique<RoadReflectionPass>(
+      block, std::vector<RoadReflectionPass::Reflected>{
+                 {vehicles, -0.02f}, {street_lights, 0.0f}, {terrain, 0.5f}, {sky, 0.0f}}));
+
+  auto& views = p.views;
+  auto& frame = p.frame;
+  const auto cockpit_view = static_cast<int>(sim::View::kCockpit);
+  const auto road_view = static_cast<int>(sim::View::kRoad);
+  frame[cockpit_view] = {p.lamp_map, p.reflection};
+  views[cockpit_view] = {
+      cockpit, vehicles,        street_lights,    road,        terrain,        sky, glow, rain,
+      spray,   spray_composite, glass_water_mask, glass_water, glass_composite};
+  frame[road_view] = {p.lamp_map, p.reflection};
+  views[road_view] = {vehicles, street_lights, road,  terrain,        sky,
+                      glow,     rain,          spray, spray_composite};
+  views[static_cast<int>(sim::View::kWindshield)] = {windshield};
+  // The rain layer alone from the driver's eye: the scene for its depth alone (no lamp map, no
+  // mirror), then black, then rain and spray.
+  views[static_cast<int>(sim::View::kRain)] = {
+      cockpit, vehicles, street_lights, road, terrain, rain_mask, rain, spray, spray_composite};
+  p.environment = {vehicles, street_lights, road, terrain, sky};
+  p.fixed_environment_cockpit = {environment_background, glass_water_mask, glass_water,
+                                 glass_composite};
+
+  check_pass_order("COCKPIT (fixed environment)", p.fixed_environment_cockpit);
+  check_pass_order("environment faces", p.environment);
+  for (int v = 0; v < sim::kViewCount; ++v) {
+    check_pass_order(sim::view_name(static_cast<sim::View>(v)), views[v]);
+    for (const Pass* pass : frame[v]) check_frame_pass(*pass);
+  }
+  return p;
+}
+
+}  // namespace downpour::render

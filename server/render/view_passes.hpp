@@ -1,0 +1,47 @@
+// The passes the renderer owns, and each view as lists of them: data, checked at start-up
+// (check_pass_order, check_frame_pass). Nearest first, sky last: llvmpipe tests depth before
+// shading, so what is hidden costs little, and the sky shades only the pixels left empty.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "server/render/cpu/spray_smoothing.hpp"
+#include "server/render/frame_block.hpp"
+#include "server/render/frame_lamps.hpp"
+#include "server/render/pass.hpp"
+#include "server/sim/types.hpp"
+
+namespace downpour::render {
+
+class LampMapPass;
+class RainPass;
+class RoadPass;
+class RoadReflectionPass;
+class SprayPass;
+
+struct ViewPasses {
+  std::vector<std::unique_ptr<Pass>> owned;
+  // Per view: its frame passes, drawn before the rest where they are wanted (the lamp map, the
+  // road reflection), and its passes.
+  std::array<std::vector<Pass*>, sim::kViewCount> frame;
+  std::array<std::vector<Pass*>, sim::kViewCount> views;
+  // What draws the environment probe's faces (the world outside the glass), the sky last; and,
+  // with a fixed environment, COCKPIT's passes (the probe as the background, then the glass).
+  std::vector<Pass*> environment;
+  std::vector<Pass*> fixed_environment_cockpit;
+  // Those the renderer asks or tells something of.
+  LampMapPass* lamp_map = nullptr;
+  RoadReflectionPass* reflection = nullptr;
+  RoadPass* road = nullptr;
+  RainPass* rain = nullptr;
+  SprayPass* spray = nullptr;
+};
+
+// Makes every pass and the views' lists; throws std::logic_error where a list breaks the pass
+// contract.
+ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
+                            const FrameLamps& lamps, SpraySmoothing smoothing);
+
+}  // namespace downpour::render
