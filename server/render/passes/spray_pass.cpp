@@ -318,18 +318,35 @@ std::vector<float> SprayPass::smooth_body_depth(int width, int height, glm::vec2
 
 void SprayPass::execute(const FrameContext& frame, const FrameResources& resources) {
   drawn_ = {};
-  const sim::SprayImage& image = *frame.scene.spray;
   const Camera& camera = frame.camera;
   const int width = std::max(1, (resources.view_colour.width + kScale - 1) / kScale);
   const int height = std::max(1, (resources.view_colour.height + kScale - 1) / kScale);
   const int tiles_x = (width + kTile - 1) / kTile, tiles_y = (height + kTile - 1) / kTile;
+  const glm::vec2 tan(static_cast<float>(camera.tan_half_fov_x),
+                      static_cast<float>(camera.tan_half_fov_y));
+  cull(frame, width, height, tiles_x, tiles_y);
+  Targets& t = targets(width, height);
+  if (cpu_splat_) splat_on_cpu(t, width, height, tiles_x, tan);
+  const std::size_t tiles = static_cast<std::size_t>(tiles_x) * tiles_y;
+  for (std::size_t i = 0; i < tiles; ++i) all_tiles_[i] |= liquid_tiles_[i];
+  runs_of(liquid_tiles_, tiles_x, tiles_y, width, height, liquid_runs_);
+  runs_of(body_tiles_, tiles_x, tiles_y, width, height, body_runs_);
+  runs_of(all_tiles_, tiles_x, tiles_y, width, height, all_runs_);
+  glBindVertexArray(vao_.id());
+  if (!body_.empty() || !spray_.empty()) shade_liquid(frame, resources, t, tan);
+  if (!clouds_.empty()) haze_over(frame, resources, t);
+}
+
+// Culls the parcels to the view: the body's, the spray's and the clouds in view space, and the
+// tiles of the layer each touches.
+void SprayPass::cull(const FrameContext& frame, int width, int height, int tiles_x, int tiles_y) {
+  const sim::SprayImage& image = *frame.scene.spray;
+  const Camera& camera = frame.camera;
   const float tan_x = static_cast<float>(camera.tan_half_fov_x);
   const float tan_y = static_cast<float>(camera.tan_half_fov_y);
   const float px_per_tan = 0.5f * static_cast<float>(height) / tan_y;  // layer pixels per x / z
   const glm::mat3 rotation(camera.view);
   const glm::dvec3 eye(camera.position);
-
-  // Cull to the view; the body's parcels, the spray's and the clouds in view space; tiles.
   body_.clear();
   spray_.clear();
   clouds_.clear();
@@ -378,94 +395,93 @@ void SprayPass::execute(const FrameContext& frame, const FrameResources& resourc
   drawn_.body = static_cast<std::uint32_t>(body_.size());
   drawn_.spray = static_cast<std::uint32_t>(spray_.size());
   drawn_.haze = static_cast<std::uint32_t>(clouds_.size());
-  Targets& t = targets(width, height);
-  if (cpu_splat_) {
-    // The CPU's maps say exactly which tiles hold liquid or visible haze.
-    const SprayCamera layer{width, height, glm::vec2(tan_x, tan_y)};
-    const SprayCamera quarter{t.haze_width, t.haze_height, glm::vec2(tan_x, tan_y)};
-    // The haze on the helper thread while this one draws the liquid's maps.
-    helper_.start([this, quarter] { splat_haze(quarter, clouds_, haze_pixels_); });
-    struct Join {
-      sim::WorkerThread& helper;
-      ~Join() { helper.wait(); }  // before anything it reads goes, even if this throws
-    } join{helper_};
-    splat_depth(layer, body_, spray_, maps_);
-    helper_.wait();
-    for (int y = 0; y < height; ++y) {
-      for (int x = 0; x < width; ++x) {
-        if (maps_.mask[static_cast<std::size_t>(y) * width + x] > 0.0f)
-          liquid_tiles_[static_cast<std::size_t>(y / kTile) * tiles_x + x / kTile] = 1;
-      }
+}
+
+// The CPU draws the parcels' maps and the haze (llvmpipe): its maps say exactly which tiles hold
+// liquid or visible haze.
+void SprayPass::splat_on_cpu(const Targets& t, int width, int height, int tiles_x, glm::vec2 tan) {
+  const SprayCamera layer{width, height, tan};
+  const SprayCamera quarter{t.haze_width, t.haze_height, tan};
+  // The haze on the helper thread while this one draws the liquid's maps.
+  helper_.start([this, quarter] { splat_haze(quarter, clouds_, haze_pixels_); });
+  struct Join {
+    sim::WorkerThread& helper;
+    ~Join() { helper.wait(); }  // before anything it reads goes, even if this throws
+  } join{helper_};
+  splat_depth(layer, body_, spray_, maps_);
+  helper_.wait();
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      if (maps_.mask[static_cast<std::size_t>(y) * width + x] > 0.0f)
+        liquid_tiles_[static_cast<std::size_t>(y / kTile) * tiles_x + x / kTile] = 1;
     }
-    for (int y = 0; y < t.haze_height; ++y) {
-      for (int x = 0; x < t.haze_width; ++x) {
-        if (haze_pixels_[static_cast<std::size_t>(y) * t.haze_width + x].x > kHazeVisible) {
-          // A haze pixel is 2 x 2 layer pixels; bilinear reaches one more around.
-          for (int dy = -1; dy <= 2; ++dy) {
-            for (int dx = -1; dx <= 2; ++dx) {
-              const int lx = std::clamp(x * kHazeScale + dx, 0, width - 1);
-              const int ly = std::clamp(y * kHazeScale + dy, 0, height - 1);
-              all_tiles_[static_cast<std::size_t>(ly / kTile) * tiles_x + lx / kTile] = 1;
-            }
+  }
+  for (int y = 0; y < t.haze_height; ++y) {
+    for (int x = 0; x < t.haze_width; ++x) {
+      if (haze_pixels_[static_cast<std::size_t>(y) * t.haze_width + x].x > kHazeVisible) {
+        // A haze pixel is 2 x 2 layer pixels; bilinear reaches one more around.
+        for (int dy = -1; dy <= 2; ++dy) {
+          for (int dx = -1; dx <= 2; ++dx) {
+            const int lx = std::clamp(x * kHazeScale + dx, 0, width - 1);
+            const int ly = std::clamp(y * kHazeScale + dy, 0, height - 1);
+            all_tiles_[static_cast<std::size_t>(ly / kTile) * tiles_x + lx / kTile] = 1;
           }
         }
       }
     }
   }
-  for (std::size_t i = 0; i < tiles; ++i) all_tiles_[i] |= liquid_tiles_[i];
-  runs_of(liquid_tiles_, tiles_x, tiles_y, width, height, liquid_runs_);
-  runs_of(body_tiles_, tiles_x, tiles_y, width, height, body_runs_);
-  runs_of(all_tiles_, tiles_x, tiles_y, width, height, all_runs_);
+}
 
-  const glm::vec2 size(static_cast<float>(width), static_cast<float>(height));
-  const glm::vec2 tan(tan_x, tan_y);
-  glBindVertexArray(vao_.id());
-  if (!body_.empty() || !spray_.empty()) {
-    depth_maps(frame, t);
-    // The body's front depth smoothed, over the body's tiles; elsewhere the maps' own.
-    const GLuint body_front = body_.empty() ? t.depth.id() : smooth(t, body_runs_, tan);
+// The liquid's depth maps, the body's front smoothed over its tiles, and its colour into the layer
+// where a sphere was hit.
+void SprayPass::shade_liquid(const FrameContext& frame, const FrameResources& resources, Targets& t,
+                             glm::vec2 tan) {
+  depth_maps(frame, t);
+  const glm::vec2 size(static_cast<float>(t.width), static_cast<float>(t.height));
+  // The body's front depth smoothed, over the body's tiles; elsewhere the maps' own.
+  const GLuint body_front = body_.empty() ? t.depth.id() : smooth(t, body_runs_, tan);
 
-    // The liquid's colour into the layer, where a sphere was hit.
-    glBindTextureUnit(texture_unit::kSprayDepth, t.depth.id());
-    glBindTextureUnit(texture_unit::kSpraySmooth, body_front);
-    // (Attached each frame: the renderer may have replaced the layer's texture under the same
-    // name.)
-    glNamedFramebufferTexture(t.shade_fbo.id(), GL_COLOR_ATTACHMENT0,
-                              resources.transient(Resource::kSprayLayer).colour.texture, 0);
-    glBindFramebuffer(GL_FRAMEBUFFER, t.shade_fbo.id());
-    glViewport(0, 0, width, height);
-    // The runs at depth 0 pass only where a hit left more (llvmpipe rejects the rest before
-    // shading them).
-    apply_step(kShade);
-    shade_program_.use();
-    u_shade_size_.set(size);
-    u_shade_tan_.set(tan);
-    u_shade_to_world_.set(glm::transpose(glm::mat4(rotation)));
-    u_shade_near_.set(camera.near_m);
-    u_shade_scale_.set(kScale);
-    u_shade_absorption_.set(kAbsorption);
-    draw_runs(liquid_runs_);
-    apply_own_state();
-  }
+  // The liquid's colour into the layer, where a sphere was hit.
+  glBindTextureUnit(texture_unit::kSprayDepth, t.depth.id());
+  glBindTextureUnit(texture_unit::kSpraySmooth, body_front);
+  // (Attached each frame: the renderer may have replaced the layer's texture under the same
+  // name.)
+  glNamedFramebufferTexture(t.shade_fbo.id(), GL_COLOR_ATTACHMENT0,
+                            resources.transient(Resource::kSprayLayer).colour.texture, 0);
+  glBindFramebuffer(GL_FRAMEBUFFER, t.shade_fbo.id());
+  glViewport(0, 0, t.width, t.height);
+  // The runs at depth 0 pass only where a hit left more (llvmpipe rejects the rest before
+  // shading them).
+  apply_step(kShade);
+  shade_program_.use();
+  u_shade_size_.set(size);
+  u_shade_tan_.set(tan);
+  u_shade_to_world_.set(glm::transpose(glm::mat4(glm::mat3(frame.camera.view))));
+  u_shade_near_.set(frame.camera.near_m);
+  u_shade_scale_.set(kScale);
+  u_shade_absorption_.set(kAbsorption);
+  draw_runs(liquid_runs_);
+  apply_own_state();
+}
 
-  if (!clouds_.empty()) {
-    haze_map(frame, t);
-    // The light the droplets scatter: the sky's and the scene's around them, as the rain's.
-    const Atmosphere& atm = frame.atmosphere;
-    // (Linear: the shader adds the lamps' light where their beams pass, then encodes it.)
-    const glm::vec3 light =
-        glm::mix(atm.sky_horizon, atm.ambient, 0.4f) * 0.95f + atm.sun_radiance * 0.05f;
-    glBindFramebuffer(GL_FRAMEBUFFER, resources.transient(Resource::kSprayLayer).fbo);
-    glViewport(0, 0, width, height);
-    glBindTextureUnit(texture_unit::kSprayHaze, t.haze.id());
-    haze_composite_program_.use();
-    u_haze_light_.set(light);
-    u_haze_near_.set(camera.near_m);
-    u_haze_soft_.set(kHazeSoftM);
-    apply_step(kHazeOver);
-    draw_runs(all_runs_);
-    apply_own_state();
-  }
+// The clouds' haze over the layer, lit by the light around them.
+void SprayPass::haze_over(const FrameContext& frame, const FrameResources& resources, Targets& t) {
+  haze_map(frame, t);
+  // The light the droplets scatter: the sky's and the scene's around them, as the rain's.
+  const Atmosphere& atm = frame.atmosphere;
+  // (Linear: the shader adds the lamps' light where their beams pass, then encodes it.)
+  const glm::vec3 light =
+      glm::mix(atm.sky_horizon, atm.ambient, 0.4f) * 0.95f + atm.sun_radiance * 0.05f;
+  glBindFramebuffer(GL_FRAMEBUFFER, resources.transient(Resource::kSprayLayer).fbo);
+  glViewport(0, 0, t.width, t.height);
+  glBindTextureUnit(texture_unit::kSprayHaze, t.haze.id());
+  haze_composite_program_.use();
+  u_haze_light_.set(light);
+  u_haze_near_.set(frame.camera.near_m);
+  u_haze_soft_.set(kHazeSoftM);
+  apply_step(kHazeOver);
+  draw_runs(all_runs_);
+  apply_own_state();
 }
 
 SprayCompositePass::SprayCompositePass(SharedResources&, const SprayPass& spray)

@@ -84,6 +84,12 @@ class SprayPass final : public Pass {
     Framebuffer shade_fbo;
   };
   Targets& targets(int width, int height);
+  // execute's parts, in order (spray_pass.cpp).
+  void cull(const FrameContext& frame, int width, int height, int tiles_x, int tiles_y);
+  void splat_on_cpu(const Targets& t, int width, int height, int tiles_x, glm::vec2 tan);
+  void shade_liquid(const FrameContext& frame, const FrameResources& resources, Targets& t,
+                    glm::vec2 tan);
+  void haze_over(const FrameContext& frame, const FrameResources& resources, Targets& t);
   void upload(Buffer& buffer, const void* data, std::size_t bytes);
   void draw_runs(const std::vector<glm::vec4>& runs);
   void depth_maps(const FrameContext& frame, Targets& t);
