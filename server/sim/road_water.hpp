@@ -187,6 +187,10 @@ class RoadWater {
     const glm::ivec2 d = cell - origins[level];
     return d.x >= 0 && d.y >= 0 && d.x < n_ && d.y < n_;
   }
+  // The cell levels_up levels coarser that holds a cell (in that level's grid).
+  static glm::ivec2 coarser(glm::ivec2 cell, int levels_up) {
+    return {cell.x >> levels_up, cell.y >> levels_up};  // (C++20: an arithmetic shift, floor)
+  }
   void move_to(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origins);
   // move_to's steps. The first placement: every window from the surface, the initial film.
   void place_first(const std::array<glm::ivec2, kRoadWaterMaxLevels>& origins);
