@@ -25,6 +25,7 @@
 #include "server/session/frame_scheduler.hpp"
 #include "server/session/session_registry.hpp"
 
+namespace downpour::app {
 namespace {
 
 // SIGINT and SIGTERM are blocked in every thread of ours and taken with sigtimedwait. A thread
@@ -44,13 +45,12 @@ int next_signal(const sigset_t& signals, const timespec& wait) {
 }
 
 // The server's state, into the metrics.
-void sample_metrics(downpour::app::Metrics& metrics, downpour::session::SessionRegistry& registry,
-                    const downpour::rpc::DownpourService& service,
-                    const downpour::session::FrameScheduler& scheduler, bool serving,
-                    double stalled_s) {
-  downpour::app::MetricsSample s;
+void sample_metrics(Metrics& metrics, session::SessionRegistry& registry,
+                    const rpc::DownpourService& service, const session::FrameScheduler& scheduler,
+                    bool serving, double stalled_s) {
+  MetricsSample s;
   for (const auto& session : registry.list()) {
-    if (session->config().mode == downpour::sim::Mode::kLockstep) {
+    if (session->config().mode == sim::Mode::kLockstep) {
       ++s.sessions_lockstep;
     } else {
       ++s.sessions_realtime;
@@ -61,7 +61,7 @@ void sample_metrics(downpour::app::Metrics& metrics, downpour::session::SessionR
   s.sessions_closed_idle = registry.closed_idle();
   s.steps_in_flight = service.steps_in_flight();
   s.open_streams = service.open_streams();
-  const downpour::session::SessionCost used = registry.cost_in_use();
+  const session::SessionCost used = registry.cost_in_use();
   s.pixel_rate_mpx_s = used.pixel_rate / 1e6;
   s.memory_estimate_mib = used.memory_bytes / (1024.0 * 1024.0);
   s.serving = serving;
@@ -69,35 +69,34 @@ void sample_metrics(downpour::app::Metrics& metrics, downpour::session::SessionR
   metrics.update(s);
 }
 
-}  // namespace
+// The log's level and format as configured, and the first line.
+void set_up_logging(const ServerConfig& config) {
+  spdlog::set_level(spdlog::level::from_str(config.log_level));
+  set_log_format(config.log_format);
+  spdlog::info("downpour-server {}", kVersion);
+}
 
-int main(int argc, char** argv) {
-  using namespace downpour;
-  int exit_code = 0;
-  const auto config = app::parse_config(argc, argv, &exit_code);
-  if (!config) return exit_code;
-  spdlog::set_level(spdlog::level::from_str(config->log_level));
-  app::set_log_format(config->log_format);
-  spdlog::info("downpour-server {}", app::kVersion);
-  // Security first: a server that would be exposed, or whose keys or tokens cannot be read, does
-  // not start.
-  if (const std::string problem = app::security_problem(*config); !problem.empty()) {
+// Security first: a server that would be exposed, or whose keys or tokens cannot be read, does
+// not start (false, logged). Else the tokens and the main port's credentials.
+bool load_security(const ServerConfig& config, rpc::Authenticator& auth,
+                   std::shared_ptr<grpc::ServerCredentials>& credentials) {
+  if (const std::string problem = security_problem(config); !problem.empty()) {
     spdlog::critical("{}", problem);
-    return 2;
+    return false;
   }
-  rpc::Authenticator auth;
-  std::shared_ptr<grpc::ServerCredentials> credentials;
   try {
-    if (!config->tokens_file.empty()) auth = rpc::Authenticator::from_file(config->tokens_file);
-    credentials = app::server_credentials(*config);
+    if (!config.tokens_file.empty()) auth = rpc::Authenticator::from_file(config.tokens_file);
+    credentials = server_credentials(config);
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());
-    return 2;
+    return false;
   }
-  if (config->render_threads > 0)
-    setenv("LP_NUM_THREADS", std::to_string(config->render_threads).c_str(), 1);
+  return true;
+}
 
-  // Signals go to sigwait below, not to whichever thread happens to run.
+// Signals go to next_signal (sigtimedwait), not to whichever thread happens to run: blocked here,
+// before any thread is started (they inherit the mask), with keep_signal as the handler. The set.
+sigset_t block_signals() {
   sigset_t signals;
   sigemptyset(&signals);
   sigaddset(&signals, SIGINT);
@@ -108,79 +107,106 @@ int main(int argc, char** argv) {
   sigemptyset(&keep.sa_mask);
   sigaction(SIGINT, &keep, nullptr);
   sigaction(SIGTERM, &keep, nullptr);
+  return signals;
+}
 
-  session::FrameScheduler* scheduler_ptr = nullptr;
-  session::SessionRegistry registry(config->max_sessions, [&scheduler_ptr] {
-    if (scheduler_ptr) scheduler_ptr->wake();
-  });
-  registry.set_idle_timeout_s(config->session_idle_timeout_s);
-  // Metrics first: a port that cannot be had stops the server before the GL context is made.
-  std::shared_ptr<app::Metrics> metrics;
-  if (!config->metrics_listen.empty()) {
-    try {
-      metrics = std::make_shared<app::Metrics>(config->metrics_listen);
-    } catch (const std::exception& e) {
-      spdlog::critical("{} (--metrics-listen)", e.what());
-      return 1;
-    }
-    spdlog::info("metrics on http://{}/metrics (port {})", config->metrics_listen, metrics->port());
-    if (!rpc::loopback_only(config->metrics_listen)) {
-      spdlog::warn(
-          "metrics listen beyond loopback ({}), without TLS or tokens: keep that network "
-          "private",
-          config->metrics_listen);
-    }
+// The metrics endpoint if --metrics-listen names one (else none); false (logged) where its port
+// cannot be had.
+bool open_metrics(const ServerConfig& config, std::shared_ptr<Metrics>& metrics) {
+  if (config.metrics_listen.empty()) return true;
+  try {
+    metrics = std::make_shared<Metrics>(config.metrics_listen);
+  } catch (const std::exception& e) {
+    spdlog::critical("{} (--metrics-listen)", e.what());
+    return false;
   }
+  spdlog::info("metrics on http://{}/metrics (port {})", config.metrics_listen, metrics->port());
+  if (!rpc::loopback_only(config.metrics_listen)) {
+    spdlog::warn(
+        "metrics listen beyond loopback ({}), without TLS or tokens: keep that network "
+        "private",
+        config.metrics_listen);
+  }
+  return true;
+}
+
+// The render loop's options: its renderer and encoders as configured, the metrics (if any) watching
+// its frames.
+session::SchedulerOptions scheduler_options(const ServerConfig& config,
+                                            std::shared_ptr<Metrics> metrics) {
   session::SchedulerOptions options;
-  options.observer = metrics;
-  options.renderer.platform = config->renderer;
-  options.renderer.spray_smoothing = config->spray_smoothing;
-  options.encoder_threads = config->encoder_threads;
-  session::FrameScheduler scheduler(registry, options);
+  options.observer = std::move(metrics);
+  options.renderer.platform = config.renderer;
+  options.renderer.spray_smoothing = config.spray_smoothing;
+  options.encoder_threads = config.encoder_threads;
+  return options;
+}
+
+// Starts the render loop (the EGL context and a first frame); false (logged) where it cannot.
+bool start_render_loop(session::FrameScheduler& scheduler) {
   try {
     scheduler.start();
   } catch (const std::exception& e) {
     spdlog::critical("cannot render: {}", e.what());
-    return 1;
+    return false;
   }
-  scheduler_ptr = &scheduler;
+  return true;
+}
+
+// The admission budgets sized for the renderer the render loop found.
+void admit_for_renderer(const ServerConfig& config, const session::FrameScheduler& scheduler,
+                        session::SessionRegistry& registry, Metrics* metrics) {
   const std::string renderer = scheduler.stats().renderer;
   spdlog::info("renderer: {}", renderer);
-  if (metrics) metrics->set_build_info(app::kVersion, renderer);
-  const session::AdmissionBudget budget = app::admission_budget(*config, renderer);
+  if (metrics) metrics->set_build_info(kVersion, renderer);
+  const session::AdmissionBudget budget = admission_budget(config, renderer);
   registry.set_budget(budget);
   spdlog::info("admission: {:.0f} Mpx/s, {:.0f} MiB of estimated session memory (0 = no limit)",
                budget.max_pixel_rate / 1e6, budget.max_memory_bytes / (1024.0 * 1024.0));
+}
 
+// What a request may ask for.
+rpc::Limits request_limits(const ServerConfig& config) {
   rpc::Limits limits;
-  limits.max_width = config->max_width;
-  limits.max_height = config->max_height;
-  limits.max_fps = config->max_fps;
-  road::Limits road_limits;
-  road_limits.max_total_length_m = config->max_road_km * 1000.0;
-  auto road_networks = std::make_shared<rpc::RoadNetworks>(config->maps_dir, road_limits);
-  if (!config->maps_dir.empty()) spdlog::info("maps from {}", config->maps_dir);
-  rpc::DownpourService service(registry, scheduler, limits, auth, road_networks);
-  service.set_identity(app::kVersion, config->advertise);
-  if (!config->advertise.empty()) spdlog::info("advertising {} to clients", config->advertise);
+  limits.max_width = config.max_width;
+  limits.max_height = config.max_height;
+  limits.max_fps = config.max_fps;
+  return limits;
+}
 
-  grpc::EnableDefaultHealthCheckService(true);
-  // Probes that cannot speak TLS get the health service alone, in plaintext, on its own port.
-  // It is built before reflection is enabled (a process-wide plugin), so it offers nothing else.
-  std::unique_ptr<grpc::Server> health_server;
-  if (!config->health_listen.empty()) {
-    grpc::ServerBuilder health_builder;
-    int health_port = 0;
-    health_builder.AddListeningPort(config->health_listen, grpc::InsecureServerCredentials(),
-                                    &health_port);
-    health_server = health_builder.BuildAndStart();
-    if (!health_server || health_port == 0) {
-      spdlog::critical("cannot listen on {} (--health-listen)", config->health_listen);
-      return 1;
-    }
-    health_server->GetHealthCheckService()->SetServingStatus(false);  // until the main port is up
-    spdlog::info("health alone on {} (port {})", config->health_listen, health_port);
+// The road networks sessions may name (from --maps-dir) or send.
+std::shared_ptr<rpc::RoadNetworks> road_networks(const ServerConfig& config) {
+  road::Limits road_limits;
+  road_limits.max_total_length_m = config.max_road_km * 1000.0;
+  auto networks = std::make_shared<rpc::RoadNetworks>(config.maps_dir, road_limits);
+  if (!config.maps_dir.empty()) spdlog::info("maps from {}", config.maps_dir);
+  return networks;
+}
+
+// Probes that cannot speak TLS get the health service alone, in plaintext, on its own port
+// (--health-listen; none if empty). Built before reflection is enabled (a process-wide plugin),
+// so it offers nothing else. False (logged) where the port cannot be had.
+bool start_health_server(const ServerConfig& config, std::unique_ptr<grpc::Server>& health_server) {
+  if (config.health_listen.empty()) return true;
+  grpc::ServerBuilder health_builder;
+  int health_port = 0;
+  health_builder.AddListeningPort(config.health_listen, grpc::InsecureServerCredentials(),
+                                  &health_port);
+  health_server = health_builder.BuildAndStart();
+  if (!health_server || health_port == 0) {
+    spdlog::critical("cannot listen on {} (--health-listen)", config.health_listen);
+    return false;
   }
+  health_server->GetHealthCheckService()->SetServingStatus(false);  // until the main port is up
+  spdlog::info("health alone on {} (port {})", config.health_listen, health_port);
+  return true;
+}
+
+// The gRPC server on --listen, serving `service` (and reflection); its port in `port`. None
+// (logged) where it cannot listen.
+std::unique_ptr<grpc::Server> start_server(
+    const ServerConfig& config, const std::shared_ptr<grpc::ServerCredentials>& credentials,
+    rpc::DownpourService& service, const std::shared_ptr<Metrics>& metrics, int& port) {
   // Reflection describes the public schema (proto/) to tools such as grpcurl; the calls it
   // describes still need their tokens. gRPC's built-in health service carries no descriptor of
   // its own (grpc/grpc#36665): naming our copy of health.proto's here links it into the binary,
@@ -188,10 +214,9 @@ int main(int argc, char** argv) {
   grpc::health::v1::HealthCheckRequest::descriptor();
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
-  int port = 0;
-  builder.AddListeningPort(config->listen, credentials, &port);
+  builder.AddListeningPort(config.listen, credentials, &port);
   builder.RegisterService(&service);
-  builder.SetMaxReceiveMessageSize(config->max_message_mb << 20);
+  builder.SetMaxReceiveMessageSize(config.max_message_mb << 20);
   auto interceptors = rpc::malformed_request_interceptors();
   if (metrics) {  // after malformed_request's, so that it counts the status that goes out
     interceptors.push_back(
@@ -208,49 +233,68 @@ int main(int argc, char** argv) {
   builder.AddChannelArgument(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);  // a quiet stream too
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
   if (!server || port == 0) {
-    spdlog::critical("cannot listen on {}", config->listen);
-    return 1;
+    spdlog::critical("cannot listen on {}", config.listen);
+    return nullptr;
   }
-  auto set_serving = [&](bool serving) {
-    server->GetHealthCheckService()->SetServingStatus(serving);
-    if (health_server) health_server->GetHealthCheckService()->SetServingStatus(serving);
-  };
-  // The GL context exists and a first frame rendered (scheduler.start): report SERVING.
-  set_serving(true);
+  return server;
+}
+
+// The server is up: its security and address to the log, its port to --port-file if given.
+void report_serving(const ServerConfig& config, const rpc::Authenticator& auth, int port) {
   spdlog::info("security: {}, {}",
-               config->tls_cert.empty()        ? "plaintext"
-               : config->tls_client_ca.empty() ? "TLS"
-                                               : "mutual TLS",
+               config.tls_cert.empty()        ? "plaintext"
+               : config.tls_client_ca.empty() ? "TLS"
+                                              : "mutual TLS",
                auth.requires_tokens() ? std::to_string(auth.token_count()) + " tokens"
                                       : std::string("no tokens (every client may do everything)"));
-  spdlog::info("listening on {} (port {}), up to {} sessions", config->listen, port,
-               config->max_sessions);
-  if (!config->port_file.empty()) {
-    const std::string tmp = config->port_file + ".tmp";
+  spdlog::info("listening on {} (port {}), up to {} sessions", config.listen, port,
+               config.max_sessions);
+  if (!config.port_file.empty()) {
+    const std::string tmp = config.port_file + ".tmp";
     std::ofstream(tmp) << port << "\n";
-    std::rename(tmp.c_str(), config->port_file.c_str());
+    std::rename(tmp.c_str(), config.port_file.c_str());
   }
+}
 
-  // Serve until a signal. Four times a second the watchdog looks at the render loop: one that has
-  // not come round for --watchdog-s turns health NOT_SERVING (a balancer stops sending work) until
-  // it does again. Every --stats-interval a stats line goes to the log.
-  using Clock = std::chrono::steady_clock;
+// What the serving loop and the drain act on.
+struct Running {
+  const ServerConfig& config;
+  session::SessionRegistry& registry;
+  session::FrameScheduler& scheduler;
+  rpc::DownpourService& service;
+  grpc::Server& server;
+  grpc::Server* health_server;  // the health-only server, if any
+
+  // Health on both ports.
+  void set_serving(bool serving) const {
+    server.GetHealthCheckService()->SetServingStatus(serving);
+    if (health_server) health_server->GetHealthCheckService()->SetServingStatus(serving);
+  }
+};
+
+using Clock = std::chrono::steady_clock;
+
+// Serve until a signal; its number. Four times a second the watchdog looks at the render loop: one
+// that has not come round for --watchdog-s turns health NOT_SERVING (a balancer stops sending work)
+// until it does again. Every --stats-interval a stats line goes to the log.
+int serve_until_signal(const Running& run, const sigset_t& signals, Metrics* metrics) {
+  const ServerConfig& config = run.config;
   const auto stats_every = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(config->stats_interval_s));
+      std::chrono::duration<double>(config.stats_interval_s));
   Clock::time_point next_stats = Clock::now() + stats_every;
   const timespec quarter{0, 250'000'000};
   bool serving = true;
-  int signal_number = 0;
   for (;;) {
-    signal_number = next_signal(signals, quarter);
-    if (signal_number > 0) break;
+    const int signal_number = next_signal(signals, quarter);
+    if (signal_number > 0) return signal_number;
     const Clock::time_point now = Clock::now();
-    const double stalled = scheduler.stalled_s(now);
-    const bool healthy = config->watchdog_s <= 0.0 || stalled < config->watchdog_s;
-    if (metrics) sample_metrics(*metrics, registry, service, scheduler, serving, stalled);
+    const double stalled = run.scheduler.stalled_s(now);
+    const bool healthy = config.watchdog_s <= 0.0 || stalled < config.watchdog_s;
+    if (metrics)
+      sample_metrics(*metrics, run.registry, run.service, run.scheduler, serving, stalled);
     if (healthy != serving) {
       serving = healthy;
-      set_serving(serving);
+      run.set_serving(serving);
       if (serving) {
         spdlog::warn("watchdog: the render loop came round again; SERVING");
       } else {
@@ -260,24 +304,29 @@ int main(int argc, char** argv) {
     }
     if (now < next_stats) continue;
     next_stats = now + stats_every;
-    const session::SchedulerStats s = scheduler.stats();
+    const session::SchedulerStats s = run.scheduler.stats();
     spdlog::info(
         "stats: {} sessions, {} frames rendered, {} encoded, render {:.2f} ms, encode {:.2f} ms "
         "(medians)",
-        registry.list().size(), s.frames_rendered, s.frames_encoded, s.render_ms_median,
+        run.registry.list().size(), s.frames_rendered, s.frames_encoded, s.render_ms_median,
         s.encode_ms_median);
   }
-  // Drain: refuse new work, answer the steps already accepted, end every stream with UNAVAILABLE,
-  // and be gone within the grace (a second signal skips the wait for steps).
+}
+
+// Drain: refuse new work, answer the steps already accepted, end every stream with UNAVAILABLE,
+// and be gone within the grace (a second signal skips the wait for steps).
+void drain(const Running& run, const sigset_t& signals, int signal_number) {
+  const ServerConfig& config = run.config;
+  rpc::DownpourService& service = run.service;
   const Clock::time_point drain_start = Clock::now();
   const Clock::time_point deadline =
       drain_start + std::chrono::duration_cast<Clock::duration>(
-                        std::chrono::duration<double>(config->shutdown_grace_s));
+                        std::chrono::duration<double>(config.shutdown_grace_s));
   // What the steps leave of the grace for ending the streams and stopping the render loop.
   const auto reserve = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(std::min(2.0, config->shutdown_grace_s * 0.25)));
+      std::chrono::duration<double>(std::min(2.0, config.shutdown_grace_s * 0.25)));
   spdlog::info("signal {}: draining ({} steps in flight; grace {:.0f} s)", signal_number,
-               service.steps_in_flight(), config->shutdown_grace_s);
+               service.steps_in_flight(), config.shutdown_grace_s);
   // A render loop stuck in the driver cannot stop: past the grace (and a second to log) the
   // process ends anyway, so that an orchestrator's SIGKILL is never what ends it.
   std::thread([deadline] {
@@ -287,7 +336,7 @@ int main(int argc, char** argv) {
     std::_Exit(2);
   }).detach();
   service.begin_drain();  // before health says so: a client that sees NOT_SERVING is refused
-  set_serving(false);
+  run.set_serving(false);
   const timespec poll{0, 10'000'000};
   while (service.steps_in_flight() > 0 && Clock::now() < deadline - reserve) {
     if (next_signal(signals, poll) > 0) {
@@ -298,15 +347,65 @@ int main(int argc, char** argv) {
   }
   if (const int left = service.steps_in_flight(); left > 0)
     spdlog::warn("{} steps were still in flight at the end of the grace", left);
-  registry.close_all({session::EndReason::kShuttingDown, "server shutting down"});
+  run.registry.close_all({session::EndReason::kShuttingDown, "server shutting down"});
   // The streams send their status; one whose reader has stalled cannot, and is cancelled.
   const Clock::time_point flushed =
       std::min(Clock::now() + std::chrono::milliseconds(500), deadline);
   while (service.open_streams() > 0 && Clock::now() < flushed) next_signal(signals, poll);
-  server->Shutdown(std::chrono::system_clock::now());  // cancels what is left
-  if (health_server) health_server->Shutdown(std::chrono::system_clock::now());
-  scheduler.stop();
+  run.server.Shutdown(std::chrono::system_clock::now());  // cancels what is left
+  if (run.health_server) run.health_server->Shutdown(std::chrono::system_clock::now());
+  run.scheduler.stop();
   spdlog::info("stopped after {:.2f} s of drain",
                std::chrono::duration<double>(Clock::now() - drain_start).count());
+}
+
+}  // namespace
+}  // namespace downpour::app
+
+int main(int argc, char** argv) {
+  using namespace downpour;
+  int exit_code = 0;
+  const auto config = app::parse_config(argc, argv, &exit_code);
+  if (!config) return exit_code;
+  app::set_up_logging(*config);
+  rpc::Authenticator auth;
+  std::shared_ptr<grpc::ServerCredentials> credentials;
+  if (!app::load_security(*config, auth, credentials)) return 2;
+  if (config->render_threads > 0)
+    setenv("LP_NUM_THREADS", std::to_string(config->render_threads).c_str(), 1);
+  const sigset_t signals = app::block_signals();
+
+  session::FrameScheduler* scheduler_ptr = nullptr;
+  session::SessionRegistry registry(config->max_sessions, [&scheduler_ptr] {
+    if (scheduler_ptr) scheduler_ptr->wake();
+  });
+  registry.set_idle_timeout_s(config->session_idle_timeout_s);
+  // Metrics first: a port that cannot be had stops the server before the GL context is made.
+  std::shared_ptr<app::Metrics> metrics;
+  if (!app::open_metrics(*config, metrics)) return 1;
+  session::FrameScheduler scheduler(registry, app::scheduler_options(*config, metrics));
+  if (!app::start_render_loop(scheduler)) return 1;
+  scheduler_ptr = &scheduler;
+  app::admit_for_renderer(*config, scheduler, registry, metrics.get());
+
+  rpc::DownpourService service(registry, scheduler, app::request_limits(*config), auth,
+                               app::road_networks(*config));
+  service.set_identity(app::kVersion, config->advertise);
+  if (!config->advertise.empty()) spdlog::info("advertising {} to clients", config->advertise);
+
+  grpc::EnableDefaultHealthCheckService(true);
+  std::unique_ptr<grpc::Server> health_server;  // before the main server (and its reflection)
+  if (!app::start_health_server(*config, health_server)) return 1;
+  int port = 0;
+  const std::unique_ptr<grpc::Server> server =
+      app::start_server(*config, credentials, service, metrics, port);
+  if (!server) return 1;
+  const app::Running running{*config, registry, scheduler, service, *server, health_server.get()};
+  // The GL context exists and a first frame rendered (scheduler.start): report SERVING.
+  running.set_serving(true);
+  app::report_serving(*config, auth, port);
+
+  const int signal_number = app::serve_until_signal(running, signals, metrics.get());
+  app::drain(running, signals, signal_number);
   return 0;
 }
