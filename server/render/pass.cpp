@@ -11,32 +11,77 @@ namespace downpour::render {
 
 namespace {
 
-constexpr std::array<float, 4> kClear{0.0f, 0.0f, 0.0f, 0.0f};
-constexpr std::array<float, 4> kBlack{0.0f, 0.0f, 0.0f, 1.0f};
+using R = Resource;
+constexpr float kFar = 1.0e6f;  // kSprayFar (cpu/spray_splat.hpp)
 
 constexpr ResourceInfo kResources[] = {
-    {Resource::kViewColour, "view colour", texture_unit::kViewColour, false, true, kNotTransient,
-     false, kClear, 0.0f},
-    {Resource::kViewDepth, "view depth", texture_unit::kViewDepth, false, true, kNotTransient,
-     false, kClear, 0.0f},
+    {.resource = R::kViewColour,
+     .name = "view colour",
+     .texture_unit = texture_unit::kViewColour,
+     .view_target = true},
+    {.resource = R::kViewDepth,
+     .name = "view depth",
+     .texture_unit = texture_unit::kViewDepth,
+     .view_target = true},
     // Its depth: the nearest water (1, reversed-Z), for the mask.
-    {Resource::kGlassLayer, "glass layer", texture_unit::kGlassLayer, false, false, kGlassLayerSize,
-     true, kClear, 1.0f},
+    {.resource = R::kGlassLayer,
+     .name = "glass layer",
+     .texture_unit = texture_unit::kGlassLayer,
+     .scale = kGlassLayerSize,
+     .depth_from = R::kGlassLayer,
+     .clear_depth = 1.0f},
     // (Three texture buffers at their own units: RenderSession::Impl::upload_glass_surface.)
-    {Resource::kGlassSurface, "glass water surface", 0, true, false, kNotTransient, false, kClear,
-     0.0f},
-    {Resource::kEnvironment, "environment", texture_unit::kEnvironment, true, false, kNotTransient,
-     false, kClear, 0.0f},
-    {Resource::kRoadWater, "road water", texture_unit::kRoadWater, true, false, kNotTransient,
-     false, kClear, 0.0f},
-    // Its depth: the far plane (0, reversed-Z), as a view's.
-    {Resource::kRoadReflection, "road reflection", texture_unit::kReflection, true, false,
-     kRoadReflectionScale, true, kBlack, 0.0f},
-    {Resource::kSprayLayer, "spray layer", texture_unit::kSprayLayer, false, false,
-     kSprayLayerScale, false, kClear, 0.0f},
+    {.resource = R::kGlassSurface, .name = "glass water surface", .from_frame = true},
+    {.resource = R::kEnvironment,
+     .name = "environment",
+     .texture_unit = texture_unit::kEnvironment,
+     .from_frame = true},
+    {.resource = R::kRoadWater,
+     .name = "road water",
+     .texture_unit = texture_unit::kRoadWater,
+     .from_frame = true},
+    // Black where nothing is mirrored; its depth the far plane (0, reversed-Z), as a view's.
+    {.resource = R::kRoadReflection,
+     .name = "road reflection",
+     .texture_unit = texture_unit::kReflection,
+     .from_frame = true,
+     .scale = kRoadReflectionScale,
+     .depth_from = R::kRoadReflection,
+     .clear_colour = {0.0f, 0.0f, 0.0f, 1.0f}},
+    // Its depth: the spray's mask, so that the liquid's colour is shaded only where a sphere hit.
+    {.resource = R::kSprayLayer,
+     .name = "spray layer",
+     .texture_unit = texture_unit::kSprayLayer,
+     .scale = kSprayLayerScale,
+     .depth_from = R::kSprayMaps},
+    // Nothing anywhere (kFar), and the mask's depth 0: no sphere hit.
+    {.resource = R::kSprayMaps,
+     .name = "spray depth maps",
+     .texture_unit = texture_unit::kSprayDepth,
+     .scale = kSprayLayerScale,
+     .format = Format::kRgba32f,
+     .linear = false,
+     .depth_from = R::kSprayMaps,
+     .clear_colour = {kFar, kFar, kFar, kFar}},
+    // Smoothed where the mask holds the body, against it.
+    {.resource = R::kSprayBodyFront,
+     .name = "spray body front",
+     .texture_unit = texture_unit::kSpraySmooth,
+     .scale = kSprayLayerScale,
+     .format = Format::kR32f,
+     .linear = false,
+     .depth_from = R::kSprayMaps,
+     .clear_colour = {kFar, kFar, kFar, kFar}},
+    {.resource = R::kSprayHaze,
+     .name = "spray haze",
+     .texture_unit = texture_unit::kSprayHaze,
+     .scale = kSprayHazeOverLayer * kSprayLayerScale,
+     .format = Format::kRg32f},
     // (Its two rings are the lamp map's own targets.)
-    {Resource::kLampMap, "lamp map", texture_unit::kLampMap, true, false, kNotTransient, false,
-     kClear, 0.0f},
+    {.resource = R::kLampMap,
+     .name = "lamp map",
+     .texture_unit = texture_unit::kLampMap,
+     .from_frame = true},
 };
 static_assert(std::size(kResources) == kResourceCount);
 constexpr bool in_order() {
@@ -76,7 +121,12 @@ void check_pass_order(std::string_view view, const std::vector<Pass*>& passes) {
                              ": must write one target");
     }
     for (Resource r : d.writes) {
-      if (resource_info(r).from_frame) fail(d, "cannot write", r);
+      const ResourceInfo& info = resource_info(r);
+      if (info.from_frame) fail(d, "cannot write", r);
+      // A target drawn against another's depth (the spray's mask) comes after that one's pass.
+      if (info.depth_from && *info.depth_from != r &&
+          std::find(available.begin(), available.end(), *info.depth_from) == available.end())
+        fail(d, "draws against the depth of what no pass wrote yet:", *info.depth_from);
       available.push_back(r);
     }
   }

@@ -6,6 +6,24 @@
 
 namespace downpour::render {
 
+namespace {
+
+GLenum gl_format(Format f) {
+  switch (f) {
+    case Format::kRgba32f:
+      return GL_RGBA32F;
+    case Format::kR32f:
+      return GL_R32F;
+    case Format::kRg32f:
+      return GL_RG32F;
+    case Format::kRgba8:
+      break;
+  }
+  return GL_RGBA8;
+}
+
+}  // namespace
+
 Framebuffer framebuffer_with(GLuint colour, GLuint depth) {
   GLuint fb = 0;
   glCreateFramebuffers(1, &fb);
@@ -47,20 +65,25 @@ Transient& TransientTargets::get(Resource r, int width, int height, std::uint64_
     it->second.last_frame = frame;
     return it->second;
   }
+  const ResourceInfo& info = resource_info(r);
   Transient t;
   t.last_frame = frame;
   t.width = width;
   t.height = height;
-  t.texture = make_texture_2d(GL_RGBA8, width, height);
-  if (resource_info(r).depth) {
+  t.texture = make_texture_2d(gl_format(info.format), width, height);
+  const GLint filter = info.linear ? GL_LINEAR : GL_NEAREST;
+  glTextureParameteri(t.texture.id(), GL_TEXTURE_MIN_FILTER, filter);
+  glTextureParameteri(t.texture.id(), GL_TEXTURE_MAG_FILTER, filter);
+  glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  if (info.depth_from == r) {
     t.depth = make_texture_2d(GL_DEPTH_COMPONENT32F, width, height);
     glTextureParameteri(t.depth.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTextureParameteri(t.depth.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     glTextureParameteri(t.depth.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(t.depth.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   }
-  glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(t.texture.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  // (A borrowed depth is attached as the frame binds it: its owner may be made again.)
   t.fbo = framebuffer_with(t.texture.id(), t.depth.id());
   return targets_.emplace(key, std::move(t)).first->second;
 }

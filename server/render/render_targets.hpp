@@ -1,6 +1,6 @@
 // The renderer's GL targets: each view's colour, depth and readback buffers (ViewTarget), and the
-// targets that live within a frame (the glass layer, the spray layer, the road reflection), made
-// as the resource table says (pass.hpp's ResourceInfo) and kept by size (TransientTargets).
+// targets that live within a frame (the glass layer, the road reflection, the spray's), made as
+// the resource table says (resource.hpp's ResourceInfo) and kept by size (TransientTargets).
 #pragma once
 
 #include <array>
@@ -40,7 +40,7 @@ struct ViewTarget {
 // A target that lives only within a frame.
 struct Transient {
   Texture texture;
-  Texture depth;  // where its resource has one (ResourceInfo::depth)
+  Texture depth;  // its own, where its resource has one (ResourceInfo::depth_from)
   Framebuffer fbo;
   int width = 0;
   int height = 0;

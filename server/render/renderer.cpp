@@ -15,6 +15,7 @@
 #include <spdlog/spdlog.h>
 
 #include "server/render/cpu/shader_interface.hpp"
+#include "server/render/cpu/spray_splat.hpp"
 #include "server/render/environment_probe.hpp"
 #include "server/render/frame_block.hpp"
 #include "server/render/frame_context.hpp"
@@ -157,6 +158,9 @@ struct Renderer::Impl {
         break;
       case Resource::kGlassLayer:
       case Resource::kSprayLayer:
+      case Resource::kSprayMaps:
+      case Resource::kSprayBodyFront:
+      case Resource::kSprayHaze:
         texture = r.transient(res).colour.texture;
         break;
       case Resource::kRoadReflection:
@@ -185,6 +189,30 @@ struct Renderer::Impl {
     glBindTextureUnit(resource_info(res).texture_unit, texture);
   }
 
+  // A transient's size for a frame of this view.
+  static glm::ivec2 transient_size(const ResourceInfo& info, const FrameContext& f) {
+    const int w = f.spec.width, h = f.spec.height, k = info.scale;
+    return k == kGlassLayerSize
+               ? f.glass.layer_size(w, h)
+               : glm::ivec2(std::max(1, (w + k - 1) / k), std::max(1, (h + k - 1) / k));
+  }
+
+  // For a view of a new size: the transients its passes write, and the spray's CPU buffers, made
+  // now rather than when the first water or spray shows (a session's memory is taken when its
+  // views are).
+  void prepare(const FrameContext& f) {
+    const auto& list = passes.views[static_cast<int>(f.spec.view)];
+    for (const Pass* pass : list) {
+      for (Resource res : pass->decl().writes) {
+        const ResourceInfo& info = resource_info(res);
+        if (info.scale == kNotTransient) continue;
+        const glm::ivec2 size = transient_size(info, f);
+        transients.get(res, size.x, size.y, frame);
+      }
+    }
+    if (lists(list, passes.spray)) passes.spray->prepare(f.spec.width, f.spec.height);
+  }
+
   // The framebuffer a pass writes: the view's, a transient made as the resource table says
   // (cleared by its first pass of the frame), or the pass's own (it binds them).
   void bind_target(Resource out, const FrameContext& f, FrameResources& r) {
@@ -195,13 +223,15 @@ struct Renderer::Impl {
       return;
     }
     if (info.scale == kNotTransient) return;
-    const int w = r.view_colour.width, h = r.view_colour.height, k = info.scale;
-    const glm::ivec2 size = k == kGlassLayerSize ? f.glass.layer_size(w, h)
-                                                 : glm::ivec2(std::max(1, (w + k - 1) / k),
-                                                              std::max(1, (h + k - 1) / k));
+    const glm::ivec2 size = transient_size(info, f);
     Transient& t = transients.get(out, size.x, size.y, frame);
+    GLuint depth = t.depth.id();
+    if (info.depth_from && *info.depth_from != out) {  // another's (drawn before: check_pass_order)
+      depth = transients.get(*info.depth_from, size.x, size.y, frame).depth.id();
+      glNamedFramebufferTexture(t.fbo.id(), GL_DEPTH_ATTACHMENT, depth, 0);
+    }
     r.transients[index(out)] = {
-        {t.texture.id(), t.width, t.height}, {t.depth.id(), t.width, t.height}, t.fbo.id()};
+        {t.texture.id(), t.width, t.height}, {depth, t.width, t.height}, t.fbo.id()};
     glBindFramebuffer(GL_FRAMEBUFFER, t.fbo.id());
     glViewport(0, 0, t.width, t.height);
     if (written[index(out)]) return;
@@ -276,9 +306,9 @@ const std::string& Renderer::gl_renderer() const { return impl_->context->render
 const std::string& Renderer::platform() const { return impl_->context->platform(); }
 void Renderer::set_profiling(bool on) { impl_->profiling = on; }
 void Renderer::set_spray_smoothing(SpraySmoothing smoothing) {
-  impl_->passes.spray->set_smoothing(smoothing);
+  impl_->passes.spray_smooth->set_smoothing(smoothing);
 }
-SpraySmoothing Renderer::spray_smoothing() const { return impl_->passes.spray->smoothing(); }
+SpraySmoothing Renderer::spray_smoothing() const { return impl_->passes.spray_smooth->smoothing(); }
 void Renderer::set_relief_shadows(bool on) { impl_->passes.road->set_relief_shadows(on); }
 void Renderer::set_lamps(bool on) { impl_->lamps_on = on; }
 bool Renderer::last_drew_relief() const { return impl_->view_drew_relief; }
@@ -288,7 +318,35 @@ std::vector<float> Renderer::smooth_spray_body(int width, int height, float tan_
                                                const std::vector<float>& front) {
   if (width <= 0 || height <= 0 || front.size() != static_cast<std::size_t>(width) * height)
     throw std::invalid_argument("smooth_spray_body: the depths do not fill the size");
-  return impl_->passes.spray->smooth_body_depth(width, height, glm::vec2(tan_x, tan_y), front);
+  Impl& m = *impl_;
+  // The body's front and its mask into the spray's maps, as the spray pass leaves them.
+  std::vector<glm::vec4> depth(front.size(), glm::vec4(kSprayFar));
+  std::vector<float> mask(front.size(), 0.0f);
+  for (std::size_t i = 0; i < front.size(); ++i) {
+    depth[i].x = front[i];
+    if (front[i] < 0.5f * kSprayFar) mask[i] = kSprayMaskBody;
+  }
+  Transient& maps = m.transients.get(Resource::kSprayMaps, width, height, m.frame);
+  Transient& out = m.transients.get(Resource::kSprayBodyFront, width, height, m.frame);
+  glNamedFramebufferTexture(out.fbo.id(), GL_DEPTH_ATTACHMENT, maps.depth.id(), 0);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureSubImage2D(maps.texture.id(), 0, 0, 0, width, height, GL_RGBA, GL_FLOAT, depth.data());
+  glTextureSubImage2D(maps.depth.id(), 0, 0, 0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT,
+                      mask.data());
+  const float far[4] = {kSprayFar, kSprayFar, kSprayFar, kSprayFar};
+  glClearNamedFramebufferfv(out.fbo.id(), GL_COLOR, 0, far);
+  const FrameTarget maps_target{
+      {maps.texture.id(), width, height}, {maps.depth.id(), width, height}, maps.fbo.id()};
+  const FrameTarget out_target{
+      {out.texture.id(), width, height}, {maps.depth.id(), width, height}, out.fbo.id()};
+  apply(m.passes.spray_smooth->decl().state);
+  m.passes.spray_smooth->smooth(maps_target, out_target, {glm::vec4(0.0f, 0.0f, 1.0f, 1.0f)},
+                                glm::vec2(tan_x, tan_y));
+  std::vector<float> z(front.size());
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glGetTextureImage(out.texture.id(), 0, GL_RED, GL_FLOAT,
+                    static_cast<GLsizei>(z.size() * sizeof(float)), z.data());
+  return z;
 }
 std::array<std::uint32_t, 3> Renderer::last_spray_drawn() const {
   const SprayPass::Drawn& d = impl_->passes.spray->drawn();
@@ -329,14 +387,11 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
   if (view_index < 0) throw std::logic_error("negative view index");
   if (s.views.size() <= static_cast<std::size_t>(view_index)) s.views.resize(view_index + 1);
   auto& target = s.views[view_index];
-  if (!target || target->width != spec.width || target->height != spec.height) {
+  const bool new_target = !target || target->width != spec.width || target->height != spec.height;
+  if (new_target) {
     if (target && target->busy())
       throw std::logic_error("render target resized with a readback in flight");
     target = std::make_unique<ViewTarget>(spec.width, spec.height);
-    // The spray's targets and buffers for this size now, not when the first spray shows (a
-    // session's memory is taken when its views are).
-    if (lists(m.passes.views[static_cast<int>(spec.view)], m.passes.spray))
-      m.passes.spray->prepare(spec.width, spec.height);
   }
   const int slot = target->next_slot;
   target->next_slot = (slot + 1) % kReadbackSlots;
@@ -352,6 +407,7 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
       GlassView(camera, scene.glass, spec.height, m.min_glass_layer_scale, m.glass_layer_widening),
       stepped};
   frame.world = &m.worlds.get(scene.roads);
+  if (new_target) m.prepare(frame);
   FrameResources resources;
   resources.view_fbo = target->fbo.id();
   resources.view_colour = {target->colour.id(), spec.width, spec.height};

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string_view>
 
 namespace downpour::render {
@@ -26,35 +27,50 @@ enum class Resource : std::uint8_t {
   // wet.
   kRoadReflection,
   kSprayLayer,  // the spray over the scene, a third of the view, premultiplied
+  // The spray's liquid at the layer's size: the four depth maps (front and back of the body and
+  // of the lone spray) and, as its depth, the mask of what a sphere hit (spray_pass.hpp).
+  kSprayMaps,
+  kSprayBodyFront,  // the body's front distance, smoothed (seed 001's screen-space surface)
+  kSprayHaze,       // the clouds' optical depth, and times distance, at half the layer's size
   // The lamps' light on the ground around the camera (lamp_map.hpp): drawn by a frame pass
   // (lamp_map_pass.hpp) where the frame has lamps; read weighted by the frame block's lamp_map.x,
   // which is 0 where it was not drawn.
   kLampMap,
 };
-inline constexpr std::size_t kResourceCount = 9;
+inline constexpr std::size_t kResourceCount = 12;
+
+inline constexpr int kNotTransient = -1;
+inline constexpr int kGlassLayerSize = 0;
+inline constexpr int kSprayLayerScale = 3;      // the spray layer: a third of the view each way
+inline constexpr int kRoadReflectionScale = 4;  // the road reflection: a quarter
+
+inline constexpr int kSprayHazeOverLayer = 2;  // the spray's haze: half the layer each way
+
+// A transient's colour format.
+enum class Format : std::uint8_t { kRgba8, kRgba32f, kR32f, kRg32f };
 
 // What the renderer knows of each resource, in one table (pass.cpp).
 struct ResourceInfo {
   Resource resource;
   std::string_view name;
-  unsigned texture_unit;  // where a pass that reads it finds it (shader_interface.hpp)
+  unsigned texture_unit = 0;  // where a pass that reads it finds it (shader_interface.hpp)
   // There from the frame's start: the simulation's, uploaded on first read, or drawn by a frame
   // pass before the view's passes. Only a frame pass writes one.
-  bool from_frame;
-  bool view_target;  // the view's own colour or depth
-  // A transient, made by the renderer for the pass that writes it and kept by size
+  bool from_frame = false;
+  bool view_target = false;  // the view's own colour or depth
+  // A transient, made by the renderer for the passes that write it and kept by size
   // (render_targets.hpp): its size is the view's over `scale` each way, or the glass layer's own
   // (GlassView::layer_size) for kGlassLayerSize; kNotTransient for the rest.
-  int scale;
-  bool depth;  // a transient with a depth attachment of its own
-  // What a transient holds before the first pass of a frame draws into it.
-  std::array<float, 4> clear_colour;
-  float clear_depth;
+  int scale = kNotTransient;
+  Format format = Format::kRgba8;
+  bool linear = true;  // read with bilinear filtering, else the nearest texel
+  // The depth attached to a transient's framebuffer: its own (this resource), another
+  // transient's of the same size (the spray's mask, for the tests against it), or none.
+  std::optional<Resource> depth_from = std::nullopt;
+  // What a transient holds before the first pass of a frame draws into it (its own depth too).
+  std::array<float, 4> clear_colour = {0.0f, 0.0f, 0.0f, 0.0f};
+  float clear_depth = 0.0f;
 };
-inline constexpr int kNotTransient = -1;
-inline constexpr int kGlassLayerSize = 0;
-inline constexpr int kSprayLayerScale = 3;      // the spray layer: a third of the view each way
-inline constexpr int kRoadReflectionScale = 4;  // the road reflection: a quarter
 const ResourceInfo& resource_info(Resource resource);
 inline std::string_view resource_name(Resource resource) { return resource_info(resource).name; }
 

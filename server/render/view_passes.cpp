@@ -45,10 +45,16 @@ ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
   Pass* glass_water_mask = own(std::make_unique<GlassWaterMaskPass>(shared, *glass_water));
   Pass* glass_composite = own(std::make_unique<GlassCompositePass>(shared));
   Pass* windshield = own(std::make_unique<WindshieldPass>(shared));
+  // The spray's chain: maps, smoothing, shading, haze, haze over, composite (spray_pass.hpp).
   p.spray = own(std::make_unique<SprayPass>(shared));
-  p.spray->set_smoothing(smoothing);
-  Pass* spray = p.spray;
-  Pass* spray_composite = own(std::make_unique<SprayCompositePass>(shared, *p.spray));
+  p.spray_smooth = own(std::make_unique<SpraySmoothPass>(shared, *p.spray));
+  p.spray_smooth->set_smoothing(smoothing);
+  const std::vector<Pass*> spray = {p.spray,
+                                    p.spray_smooth,
+                                    own(std::make_unique<SprayShadePass>(shared, *p.spray)),
+                                    own(std::make_unique<SprayHazePass>(shared, *p.spray)),
+                                    own(std::make_unique<SprayHazeOverPass>(shared, *p.spray)),
+                                    own(std::make_unique<SprayCompositePass>(shared, *p.spray))};
   p.lamp_map = own(std::make_unique<LampMapPass>(lamps));
   // What the road's mirror shows, each clipped this far above the road's plane.
   p.reflection = own(std::make_unique<RoadReflectionPass>(
@@ -59,18 +65,21 @@ ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
   auto& frame = p.frame;
   const auto cockpit_view = static_cast<int>(sim::View::kCockpit);
   const auto road_view = static_cast<int>(sim::View::kRoad);
+  auto then = [](std::vector<Pass*> a, const std::vector<Pass*>& b) {
+    a.insert(a.end(), b.begin(), b.end());
+    return a;
+  };
   frame[cockpit_view] = {p.lamp_map, p.reflection};
-  views[cockpit_view] = {
-      cockpit, vehicles,        street_lights,    road,        terrain,        sky, glow, rain,
-      spray,   spray_composite, glass_water_mask, glass_water, glass_composite};
+  views[cockpit_view] =
+      then(then({cockpit, vehicles, street_lights, road, terrain, sky, glow, rain}, spray),
+           {glass_water_mask, glass_water, glass_composite});
   frame[road_view] = {p.lamp_map, p.reflection};
-  views[road_view] = {vehicles, street_lights, road,  terrain,        sky,
-                      glow,     rain,          spray, spray_composite};
+  views[road_view] = then({vehicles, street_lights, road, terrain, sky, glow, rain}, spray);
   views[static_cast<int>(sim::View::kWindshield)] = {windshield};
   // The rain layer alone from the driver's eye: the scene for its depth alone (no lamp map, no
   // mirror), then black, then rain and spray.
-  views[static_cast<int>(sim::View::kRain)] = {
-      cockpit, vehicles, street_lights, road, terrain, rain_mask, rain, spray, spray_composite};
+  views[static_cast<int>(sim::View::kRain)] =
+      then({cockpit, vehicles, street_lights, road, terrain, rain_mask, rain}, spray);
   p.environment = {vehicles, street_lights, road, terrain, sky};
   p.fixed_environment_cockpit = {environment_background, glass_water_mask, glass_water,
                                  glass_composite};

@@ -20,6 +20,7 @@ class RainPass;
 class RoadPass;
 class RoadReflectionPass;
 class SprayPass;
+class SpraySmoothPass;
 
 struct ViewPasses {
   std::vector<std::unique_ptr<Pass>> owned;
@@ -37,6 +38,7 @@ struct ViewPasses {
   RoadPass* road = nullptr;
   RainPass* rain = nullptr;
   SprayPass* spray = nullptr;
+  SpraySmoothPass* spray_smooth = nullptr;
 };
 
 // Makes every pass and the views' lists; throws std::logic_error where a list breaks the pass
