@@ -39,6 +39,9 @@ class Pass {
   // Nothing to draw this frame (clear glass) skips the pass and its target's preparation.
   virtual bool wanted(const FrameContext&) const { return true; }
   virtual void execute(const FrameContext& frame, const FrameResources& resources) = 0;
+  // The pass writes every texel of its transient that a later pass reads (the CPU's uploads): the
+  // renderer does not clear it first.
+  virtual bool overwrites_target(const FrameContext&) const { return false; }
 
  protected:
   // Applies the declared state of step `i` (PassDecl::steps); the pass's own state is `state`.

@@ -68,6 +68,7 @@ Transient& TransientTargets::get(Resource r, int width, int height, std::uint64_
   const ResourceInfo& info = resource_info(r);
   Transient t;
   t.last_frame = frame;
+  t.serial = ++made_;
   t.width = width;
   t.height = height;
   t.texture = make_texture_2d(gl_format(info.format), width, height);
@@ -86,6 +87,12 @@ Transient& TransientTargets::get(Resource r, int width, int height, std::uint64_
   // (A borrowed depth is attached as the frame binds it: its owner may be made again.)
   t.fbo = framebuffer_with(t.texture.id(), t.depth.id());
   return targets_.emplace(key, std::move(t)).first->second;
+}
+
+void TransientTargets::attach_depth(Transient& t, const Transient& owner) {
+  if (t.borrowed == owner.serial) return;
+  glNamedFramebufferTexture(t.fbo.id(), GL_DEPTH_ATTACHMENT, owner.depth.id(), 0);
+  t.borrowed = owner.serial;
 }
 
 void TransientTargets::evict() {

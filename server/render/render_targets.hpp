@@ -45,6 +45,9 @@ struct Transient {
   int width = 0;
   int height = 0;
   std::uint64_t last_frame = 0;  // the last frame that drew into it
+  std::uint64_t serial = 0;      // which target this is, never reused (GL names are)
+  // Another transient's depth (ResourceInfo::depth_from) attached to fbo: that target's serial.
+  std::uint64_t borrowed = 0;
 };
 
 class TransientTargets {
@@ -55,10 +58,13 @@ class TransientTargets {
   // frame's start, so that it never takes one a pass of the frame has bound.
   void evict();
   void clear() { targets_.clear(); }
+  // `t`'s framebuffer with `owner`'s depth attached (once per pair).
+  static void attach_depth(Transient& t, const Transient& owner);
 
  private:
   static constexpr std::size_t kMax = 12;
   std::map<std::tuple<Resource, int, int>, Transient> targets_;
+  std::uint64_t made_ = 0;
 };
 
 }  // namespace downpour::render

@@ -215,7 +215,7 @@ struct Renderer::Impl {
 
   // The framebuffer a pass writes: the view's, a transient made as the resource table says
   // (cleared by its first pass of the frame), or the pass's own (it binds them).
-  void bind_target(Resource out, const FrameContext& f, FrameResources& r) {
+  void bind_target(Resource out, const FrameContext& f, FrameResources& r, bool clear = true) {
     const ResourceInfo& info = resource_info(out);
     if (info.view_target) {
       glBindFramebuffer(GL_FRAMEBUFFER, r.view_fbo);
@@ -227,14 +227,15 @@ struct Renderer::Impl {
     Transient& t = transients.get(out, size.x, size.y, frame);
     GLuint depth = t.depth.id();
     if (info.depth_from && *info.depth_from != out) {  // another's (drawn before: check_pass_order)
-      depth = transients.get(*info.depth_from, size.x, size.y, frame).depth.id();
-      glNamedFramebufferTexture(t.fbo.id(), GL_DEPTH_ATTACHMENT, depth, 0);
+      const Transient& owner = transients.get(*info.depth_from, size.x, size.y, frame);
+      TransientTargets::attach_depth(t, owner);
+      depth = owner.depth.id();
     }
     r.transients[index(out)] = {
         {t.texture.id(), t.width, t.height}, {depth, t.width, t.height}, t.fbo.id()};
     glBindFramebuffer(GL_FRAMEBUFFER, t.fbo.id());
     glViewport(0, 0, t.width, t.height);
-    if (written[index(out)]) return;
+    if (written[index(out)] || !clear) return;
     glClearNamedFramebufferfv(t.fbo.id(), GL_COLOR, 0, info.clear_colour.data());
     if (t.depth.id()) {
       glDepthMask(GL_TRUE);  // (a depth clear obeys the depth mask)
@@ -253,7 +254,7 @@ struct Renderer::Impl {
       if (info.scale != kNotTransient && !info.from_frame && !written[index(res)]) return;
     }
     for (Resource res : d.reads) bind_read(res, f, session, r);
-    bind_target(d.writes.front(), f, r);
+    bind_target(d.writes.front(), f, r, !pass.overwrites_target(f));
     apply(d.state);
     pass.execute(f, r);
     // Clears outside the passes heed the colour mask: it is left on.
@@ -328,7 +329,7 @@ std::vector<float> Renderer::smooth_spray_body(int width, int height, float tan_
   }
   Transient& maps = m.transients.get(Resource::kSprayMaps, width, height, m.frame);
   Transient& out = m.transients.get(Resource::kSprayBodyFront, width, height, m.frame);
-  glNamedFramebufferTexture(out.fbo.id(), GL_DEPTH_ATTACHMENT, maps.depth.id(), 0);
+  TransientTargets::attach_depth(out, maps);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTextureSubImage2D(maps.texture.id(), 0, 0, 0, width, height, GL_RGBA, GL_FLOAT, depth.data());
   glTextureSubImage2D(maps.depth.id(), 0, 0, 0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT,

@@ -1,7 +1,8 @@
 // The spray (sim/spray.hpp) as seed 001's screen-space liquid, into the spray layer at a third of
 // the view's size, in six declared passes whose targets are the renderer's transients
 // (resource.hpp):
-// - spray (spray_pass.cpp): the parcels culled to the view (body or spray by neighbour count, from
+// - spray_maps (spray_pass.cpp): the parcels culled to the view (body or spray by neighbour count,
+// from
 //   the simulation, and every parcel's cloud), and the liquid into four depth maps (front and back
 //   of each) with a mask of what was hit (kSprayMaps): on a GPU as squares that ray-cast their
 //   spheres, on llvmpipe by the CPU (cpu/spray_splat.hpp: each small square cost llvmpipe about a
@@ -48,6 +49,8 @@ class SprayPass final : public Pass {
   const PassDecl& decl() const override { return decl_; }
   bool wanted(const FrameContext& frame) const override;
   void execute(const FrameContext& frame, const FrameResources& resources) override;
+  // The CPU's maps are uploaded whole where there is liquid (without it, nothing reads them).
+  bool overwrites_target(const FrameContext&) const override { return cpu_splat_; }
 
   static constexpr int kScale = kSprayLayerScale;         // the layer: the view's over this
   static constexpr int kHazeScale = kSprayHazeOverLayer;  // the haze: the layer's over this
@@ -80,7 +83,7 @@ class SprayPass final : public Pass {
   // A sphere's hit passes greater-or-equal, so that MIN blending keeps the nearest front and the
   // farthest back.
   const PassDecl decl_{
-      "spray", {}, {Resource::kSprayMaps}, {DepthTest::kNearerOrEqual, true, Blend::kMin}};
+      "spray_maps", {}, {Resource::kSprayMaps}, {DepthTest::kNearerOrEqual, true, Blend::kMin}};
   // execute's parts, in order.
   void cull(const FrameContext& frame, int width, int height, int tiles_x, int tiles_y);
   void splat_on_cpu(const FrameTarget& maps, int haze_width, int haze_height, int tiles_x,
@@ -172,6 +175,8 @@ class SprayHazePass final : public Pass {
     return spray_.wanted(frame) && !spray_.clouds().empty();
   }
   void execute(const FrameContext& frame, const FrameResources& resources) override;
+  // The CPU's haze is uploaded whole.
+  bool overwrites_target(const FrameContext&) const override { return spray_.cpu_splat(); }
 
  private:
   // The clouds' optical depth added up.

@@ -78,6 +78,7 @@ void SpraySmoothPass::smooth(const FrameTarget& maps, const FrameTarget& out,
     return;
   }
   Scratch& s = scratch(width, height);
+  // (Each time: a GL name may be reused for another texture once the maps are made again.)
   glNamedFramebufferTexture(s.fbo.id(), GL_DEPTH_ATTACHMENT, maps.depth.texture, 0);
   const float far[4] = {kSprayFar, kSprayFar, kSprayFar, kSprayFar};
   glClearNamedFramebufferfv(s.fbo.id(), GL_COLOR, 0, far);
