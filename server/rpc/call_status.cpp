@@ -24,9 +24,9 @@ class CallStatus final : public grpc::experimental::Interceptor {
   std::string_view method_;
 };
 
-class Factory final : public grpc::experimental::ServerInterceptorFactoryInterface {
+class CallStatusFactory final : public grpc::experimental::ServerInterceptorFactoryInterface {
  public:
-  explicit Factory(CallStatusCallback callback) : callback_(std::move(callback)) {}
+  explicit CallStatusFactory(CallStatusCallback callback) : callback_(std::move(callback)) {}
 
   grpc::experimental::Interceptor* CreateServerInterceptor(
       grpc::experimental::ServerRpcInfo* info) override {
@@ -59,7 +59,7 @@ std::string_view method_label(std::string_view path) {
 
 std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface> call_status_interceptor(
     CallStatusCallback callback) {
-  return std::make_unique<Factory>(std::move(callback));
+  return std::make_unique<CallStatusFactory>(std::move(callback));
 }
 
 }  // namespace downpour::rpc

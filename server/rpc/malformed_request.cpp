@@ -34,7 +34,7 @@ class MalformedRequest final : public grpc::experimental::Interceptor {
   bool malformed_ = false;
 };
 
-class Factory final : public grpc::experimental::ServerInterceptorFactoryInterface {
+class MalformedRequestFactory final : public grpc::experimental::ServerInterceptorFactoryInterface {
  public:
   grpc::experimental::Interceptor* CreateServerInterceptor(
       grpc::experimental::ServerRpcInfo* info) override {
@@ -49,7 +49,7 @@ class Factory final : public grpc::experimental::ServerInterceptorFactoryInterfa
 std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>>
 malformed_request_interceptors() {
   std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> out;
-  out.push_back(std::make_unique<Factory>());
+  out.push_back(std::make_unique<MalformedRequestFactory>());
   return out;
 }
 

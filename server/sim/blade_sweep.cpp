@@ -8,12 +8,6 @@
 #include "server/sim/water_inputs.hpp"
 
 namespace downpour::sim {
-namespace {
-
-glm::dvec2 direction(float angle_rad) { return {std::cos(angle_rad), std::sin(angle_rad)}; }
-glm::dvec2 left_normal(glm::dvec2 d) { return {-d.y, d.x}; }
-
-}  // namespace
 
 BladeSweep::BladeSweep(const WaterConfig& config, std::uint64_t seed)
     : config_(config), random_(seed, 3) {}
@@ -31,7 +25,7 @@ void BladeSweep::sweep(const WaterInputs& in, MeshModel& mesh, ParticleModel& mo
     if (turn == 0.0) continue;
     const double side = turn > 0.0 ? 1.0 : -1.0;
     const glm::dvec2 pivot(after.pivot_mm);
-    const glm::dvec2 d0 = direction(before.angle_rad), d1 = direction(after.angle_rad);
+    const glm::dvec2 d0 = blade_direction(before.angle_rad), d1 = blade_direction(after.angle_rad);
     const glm::dvec2 n0 = side * left_normal(d0), n1 = side * left_normal(d1);
     const double half = 0.5 * after.width_mm, length = after.length_mm;
     auto swept = [&](glm::dvec2 p, double r, double* along) {
@@ -46,7 +40,7 @@ void BladeSweep::sweep(const WaterInputs& in, MeshModel& mesh, ParticleModel& mo
     }
     // The swept sector's bounding box (the arc between the tips bulges out to the tip of the
     // middle direction, reached at length / cos(half the turn)), for a quick rejection.
-    const glm::dvec2 mid = direction(0.5f * (before.angle_rad + after.angle_rad));
+    const glm::dvec2 mid = blade_direction(0.5f * (before.angle_rad + after.angle_rad));
     const glm::dvec2 bulge = pivot + mid * (length / std::cos(0.5 * turn));
     const glm::dvec2 tip0 = pivot + d0 * length, tip1 = pivot + d1 * length;
     const glm::dvec2 lo = glm::min(glm::min(pivot, bulge), glm::min(tip0, tip1)) - half;

@@ -14,9 +14,6 @@ namespace {
 
 constexpr int kRepulsionIterations = 3;  // at most, per step; stops once nothing overlaps
 
-glm::dvec2 direction(float angle_rad) { return {std::cos(angle_rad), std::sin(angle_rad)}; }
-glm::dvec2 left_normal(glm::dvec2 d) { return {-d.y, d.x}; }
-
 }  // namespace
 
 ParticleModel::ParticleModel(const WaterConfig& config)
@@ -126,7 +123,7 @@ bool ParticleModel::in_region(glm::dvec2 p, const std::array<BladePose, 2>& blad
   const WaterConfig& w = config_;
   const double margin = w.region_particle_diameters * 2.0 * w.particle_radius_mm;
   for (const BladePose& b : blades) {
-    const glm::dvec2 d = direction(b.angle_rad);
+    const glm::dvec2 d = blade_direction(b.angle_rad);
     const glm::dvec2 rel = p - glm::dvec2(b.pivot_mm);
     const double along = glm::dot(d, rel), across = glm::dot(left_normal(d), rel);
     if (along >= 0.0 && along <= b.length_mm && std::abs(across) <= 0.5 * b.width_mm + margin)

@@ -9,10 +9,12 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
 
+#include <glm/ext/vector_double2.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
@@ -131,6 +133,13 @@ struct BladePose {
   float length_mm = 0.0f;
   float width_mm = 0.0f;
 };
+
+// The unit direction at `angle_rad` counter-clockwise from +u (a blade's, from its pivot), and a
+// direction's left normal (a quarter turn counter-clockwise).
+inline glm::dvec2 blade_direction(float angle_rad) {
+  return {std::cos(angle_rad), std::sin(angle_rad)};
+}
+inline glm::dvec2 left_normal(glm::dvec2 d) { return {-d.y, d.x}; }
 
 struct GlassWaterSurface;  // glass_water_surface.hpp
 

@@ -151,7 +151,9 @@ async function main() {
   await waitFor("frames in both views", () => page.evaluate(() =>
     Number(document.getElementById("img-cockpit").dataset.frame || 0) > 2 &&
     Number(document.getElementById("img-road").dataset.frame || 0) > 2), 45_000);
-  await waitFor("the HUD", () => page.$eval("#hud-cockpit", (e) => e.textContent.includes("render")));
+  // The HUD's stats come from the viewer's own watch of the session, which starts after the drive's
+  // first frames: as long a wait as for those.
+  await waitFor("the HUD", () => page.$eval("#hud-cockpit", (e) => e.textContent.includes("render")), 45_000);
   await page.screenshot({path: path.join(shots, "01-drive-start.png")});
   const cockpit = await page.$("#img-cockpit");
   const frameBefore = Number(await page.$eval("#img-cockpit", (e) => e.dataset.frame));
