@@ -46,9 +46,7 @@ EnvironmentPrograms::EnvironmentPrograms()
       u_lamp_texel_rad_(lamps_.uniform("u_texel_rad")),
       level_("fullscreen.vert", "environment_level.frag"),
       u_layer_(level_.uniform("u_layer")) {
-  GLuint vao = 0;
-  glCreateVertexArrays(1, &vao);
-  empty_vao_ = VertexArray(vao);
+  empty_vao_ = make_vertex_array();
   // A lookup near a face's edge filters across into its neighbour.
   glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
 }

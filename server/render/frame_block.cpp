@@ -97,11 +97,9 @@ FrameBlock make_block(const FrameContext& f, const WaterBlock& water, const Lamp
 }  // namespace
 
 FrameBlockBuffer::FrameBlockBuffer() : view_(std::make_unique<FrameBlock>()) {
-  GLuint ubo = 0;
-  glCreateBuffers(1, &ubo);
-  ubo_ = Buffer(ubo);
-  glNamedBufferStorage(ubo, sizeof(FrameBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
-  glBindBufferBase(GL_UNIFORM_BUFFER, kFrameBlockBinding, ubo);
+  ubo_ = make_buffer();
+  glNamedBufferStorage(ubo_.id(), sizeof(FrameBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  glBindBufferBase(GL_UNIFORM_BUFFER, kFrameBlockBinding, ubo_.id());
 }
 
 void FrameBlockBuffer::upload_view(const FrameContext& f, const WaterBlock& water) {

@@ -6,11 +6,9 @@
 namespace downpour::render {
 
 FrameLamps::FrameLamps() {
-  GLuint ubo = 0;
-  glCreateBuffers(1, &ubo);
-  ubo_ = Buffer(ubo);
-  glNamedBufferStorage(ubo, sizeof(LampBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
-  glBindBufferBase(GL_UNIFORM_BUFFER, kLampBlockBinding, ubo);
+  ubo_ = make_buffer();
+  glNamedBufferStorage(ubo_.id(), sizeof(LampBlock), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLampBlockBinding, ubo_.id());
 }
 
 void FrameLamps::prepare(FrameContext& f, bool on, bool map) {

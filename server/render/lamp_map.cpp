@@ -31,9 +31,7 @@ LampMap::LampMap()
       u_boxes_(program_.uniform("u_boxes")),
       texture_(make_texture_2d_array(GL_RGBA16F, LampRings::kCells, LampRings::kCells,
                                      LampRings::kRings)) {
-  GLuint vao = 0;
-  glCreateVertexArrays(1, &vao);
-  vao_ = VertexArray(vao);
+  vao_ = make_vertex_array();
   glTextureParameteri(texture_.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   glTextureParameteri(texture_.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   for (int l = 0; l < LampRings::kRings; ++l) {

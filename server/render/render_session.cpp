@@ -26,16 +26,14 @@ void RenderSession::Impl::upload_glass_surface(
       // Grown as needed (never empty: a texture buffer needs storage), else refilled.
       const std::size_t bytes = std::max<std::size_t>(parts[k].second, 16);
       if (!glass_surface[k].id() || glass_surface_bytes[k] < bytes) {
-        GLuint id = 0;
-        glCreateBuffers(1, &id);
-        glass_surface[k] = Buffer(id);
+        glass_surface[k] = make_buffer();
         glass_surface_bytes[k] = std::max(bytes, 2 * glass_surface_bytes[k]);
-        glNamedBufferStorage(id, static_cast<GLsizeiptr>(glass_surface_bytes[k]), nullptr,
-                             GL_DYNAMIC_STORAGE_BIT);
+        glNamedBufferStorage(glass_surface[k].id(), static_cast<GLsizeiptr>(glass_surface_bytes[k]),
+                             nullptr, GL_DYNAMIC_STORAGE_BIT);
         GLuint tex = 0;
         glCreateTextures(GL_TEXTURE_BUFFER, 1, &tex);
         glass_surface_tex[k] = Texture(tex);
-        glTextureBuffer(tex, kFormats[k], id);
+        glTextureBuffer(tex, kFormats[k], glass_surface[k].id());
       }
       if (parts[k].second > 0)
         glNamedBufferSubData(glass_surface[k].id(), 0, static_cast<GLsizeiptr>(parts[k].second),

@@ -29,6 +29,18 @@ GLuint compile(GLenum stage, const std::string& file) {
 
 }  // namespace
 
+VertexArray make_vertex_array() {
+  GLuint id = 0;
+  glCreateVertexArrays(1, &id);
+  return VertexArray(id);
+}
+
+Buffer make_buffer() {
+  GLuint id = 0;
+  glCreateBuffers(1, &id);
+  return Buffer(id);
+}
+
 Texture make_texture_2d(GLenum internal_format, int width, int height, int levels) {
   GLuint id = 0;
   glCreateTextures(GL_TEXTURE_2D, 1, &id);

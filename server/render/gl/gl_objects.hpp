@@ -53,6 +53,10 @@ using Buffer = GlName<gl_delete::buffer>;
 using Framebuffer = GlName<gl_delete::framebuffer>;
 using VertexArray = GlName<gl_delete::vertex_array>;
 
+// A new vertex array (the passes that draw from storage buffers bind an empty one) and buffer.
+VertexArray make_vertex_array();
+Buffer make_buffer();
+
 Texture make_texture_2d(GLenum internal_format, int width, int height, int levels = 1);
 // Layers of one size, filtered linearly within a layer.
 Texture make_texture_2d_array(GLenum internal_format, int width, int height, int layers);

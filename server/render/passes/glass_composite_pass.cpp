@@ -11,9 +11,7 @@ GlassCompositePass::GlassCompositePass(SharedResources&)
       blade_placement_(blade_program_),
       u_blur_mm_(blade_program_.uniform("u_blur_mm")),
       u_margin_mm_(blade_program_.uniform("u_margin_mm")) {
-  GLuint vao = 0;
-  glCreateVertexArrays(1, &vao);
-  empty_vao_ = VertexArray(vao);
+  empty_vao_ = make_vertex_array();
 }
 
 bool GlassCompositePass::wanted(const FrameContext& frame) const {

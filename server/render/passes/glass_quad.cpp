@@ -33,9 +33,7 @@ void GlassSurfaceGrid::set(const sim::WindshieldState& water) const {
 }
 
 GlassQuad::GlassQuad(const ShaderProgram& program) : placement_(program) {
-  GLuint vao = 0;
-  glCreateVertexArrays(1, &vao);
-  empty_vao_ = VertexArray(vao);
+  empty_vao_ = make_vertex_array();
 }
 
 void GlassQuad::draw(const FrameContext& frame) const {

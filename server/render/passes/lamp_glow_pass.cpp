@@ -58,9 +58,7 @@ LampGlowPass::LampGlowPass(SharedResources&)
     : program_("lamp_glow.vert", "lamp_glow.frag"),
       u_glows_(program_.uniform("u_glows")),
       u_pixel_(program_.uniform("u_pixel")) {
-  GLuint vao = 0;
-  glCreateVertexArrays(1, &vao);
-  vao_ = VertexArray(vao);
+  vao_ = make_vertex_array();
 }
 
 bool LampGlowPass::wanted(const FrameContext& frame) const {

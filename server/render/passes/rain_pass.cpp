@@ -20,9 +20,7 @@ RainPass::RainPass(SharedResources& shared)
     : shared_(shared),
       program_("rain.vert", "rain.frag"),
       u_plane_depth_(program_.uniform("u_plane_depth")) {
-  GLuint vao = 0;
-  glCreateVertexArrays(1, &vao);
-  vao_ = VertexArray(vao);
+  vao_ = make_vertex_array();
 }
 
 bool RainPass::wanted(const FrameContext& frame) const {
@@ -192,10 +190,8 @@ RainPass::Sized& RainPass::sized(int width, int height) {
                               ((width + RainLayer::kTile - 1) / RainLayer::kTile) *
                               ((height + RainLayer::kTile - 1) / RainLayer::kTile);
   for (Buffer& buffer : s->runs_buffer) {
-    GLuint id = 0;
-    glCreateBuffers(1, &id);
-    glNamedBufferStorage(id, capacity, nullptr, GL_DYNAMIC_STORAGE_BIT);
-    buffer = Buffer(id);
+    buffer = make_buffer();
+    glNamedBufferStorage(buffer.id(), capacity, nullptr, GL_DYNAMIC_STORAGE_BIT);
   }
   sized_.push_back(std::move(s));
   return *sized_.back();

@@ -70,12 +70,8 @@ const char* spray_smoothing_name(SpraySmoothing smoothing) {
 }
 
 TileRuns::TileRuns() {
-  GLuint vao = 0;
-  glCreateVertexArrays(1, &vao);
-  vao_ = VertexArray(vao);
-  GLuint id = 0;
-  glCreateBuffers(1, &id);
-  buffer_ = Buffer(id);
+  vao_ = make_vertex_array();
+  buffer_ = make_buffer();
 }
 
 void TileRuns::draw(const std::vector<glm::vec4>& runs) {
@@ -92,12 +88,8 @@ SprayPass::SprayPass(SharedResources&)
       u_depth_projection_(depth_program_.uniform("u_projection")),
       u_depth_spray_(depth_program_.uniform("u_spray_count")),
       u_depth_near_(depth_program_.uniform("u_near")) {
-  GLuint vao = 0;
-  glCreateVertexArrays(1, &vao);
-  vao_ = VertexArray(vao);
-  GLuint id = 0;
-  glCreateBuffers(1, &id);
-  parcels_ = Buffer(id);
+  vao_ = make_vertex_array();
+  parcels_ = make_buffer();
   const char* gl = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   const std::string renderer = gl ? gl : "";
   cpu_splat_ = renderer.find("llvmpipe") != std::string::npos ||

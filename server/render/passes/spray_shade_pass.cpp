@@ -39,12 +39,8 @@ SprayHazePass::SprayHazePass(SharedResources&, const SprayPass& spray)
     : spray_(spray),
       program_("spray_haze.vert", "spray_haze.frag"),
       u_projection_(program_.uniform("u_projection")) {
-  GLuint vao = 0;
-  glCreateVertexArrays(1, &vao);
-  vao_ = VertexArray(vao);
-  GLuint id = 0;
-  glCreateBuffers(1, &id);
-  clouds_ = Buffer(id);
+  vao_ = make_vertex_array();
+  clouds_ = make_buffer();
 }
 
 void SprayHazePass::execute(const FrameContext& frame, const FrameResources& resources) {
