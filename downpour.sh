@@ -4,7 +4,8 @@
 #   ./downpour.sh test    install what is missing, build, run every test (ctest)
 #   ./downpour.sh build   install what is missing, build (Release, into build/)
 #   ./downpour.sh server  build, then run the server alone (arguments after "server" go to it)
-#   ./downpour.sh bench   build, then run the benchmarks (JSON on stdout)
+#   ./downpour.sh bench   build with the benchmark tools (bench/, not in the default build), then run
+#                         downpour-bench (JSON on stdout)
 #   ./downpour.sh sanitize  the unit, render and integration tests under ASan+UBSan (build-asan/)
 #   ./downpour.sh tsan      the session and encoder unit tests, and the integration tests against a
 #                           server, under ThreadSanitizer (build-tsan/)
@@ -209,6 +210,7 @@ case "${1:-}" in
     ;;
   bench)
     build
+    cmake --build "$BUILD" -j "$(nproc)" --target benches  # (not in the default build)
     "$BUILD/downpour-bench" "${@:2}"
     ;;
   sanitize) sanitize ;;
