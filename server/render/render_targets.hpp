@@ -62,7 +62,9 @@ class TransientTargets {
   static void attach_depth(Transient& t, const Transient& owner);
 
  private:
-  static constexpr std::size_t kMax = 12;
+  // Four view sizes' worth: a size has up to six (the glass layer, the road reflection, the spray
+  // layer, maps, body front and haze).
+  static constexpr std::size_t kMax = 24;
   std::map<std::tuple<Resource, int, int>, Transient> targets_;
   std::uint64_t made_ = 0;
 };
