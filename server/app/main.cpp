@@ -165,12 +165,16 @@ void admit_for_renderer(const ServerConfig& config, const session::FrameSchedule
                budget.max_pixel_rate / 1e6, budget.max_memory_bytes / (1024.0 * 1024.0));
 }
 
+// How far past --max-message-mb gRPC still reads a request (for the service to refuse it clearly).
+constexpr int kRequestSlackMb = 16;
+
 // What a request may ask for.
 rpc::Limits request_limits(const ServerConfig& config) {
   rpc::Limits limits;
   limits.max_width = config.max_width;
   limits.max_height = config.max_height;
   limits.max_fps = config.max_fps;
+  limits.max_request_bytes = static_cast<std::size_t>(config.max_message_mb) << 20;
   return limits;
 }
 
@@ -216,7 +220,10 @@ std::unique_ptr<grpc::Server> start_server(
   grpc::ServerBuilder builder;
   builder.AddListeningPort(config.listen, credentials, &port);
   builder.RegisterService(&service);
-  builder.SetMaxReceiveMessageSize(config.max_message_mb << 20);
+  // gRPC takes a request somewhat past --max-message-mb, so that the service can refuse it with a
+  // status that names the flag (rpc::check_request_size); gRPC's own refusal past this says only
+  // the sizes.
+  builder.SetMaxReceiveMessageSize((config.max_message_mb + kRequestSlackMb) << 20);
   auto interceptors = rpc::malformed_request_interceptors();
   if (metrics) {  // after malformed_request's, so that it counts the status that goes out
     interceptors.push_back(

@@ -44,6 +44,9 @@ struct FrameContext {
   const std::vector<Light>* lights = nullptr;
   // What is drawn of the session's roads (world.hpp).
   const World* world = nullptr;
+  // Where a face of the environment is drawn from a client's picture: the camera the picture was
+  // taken from (the view's); null elsewhere (the frame's own camera is the picture's).
+  const Camera* picture_camera = nullptr;
 
   const sim::WindshieldState& water() const { return stepped().windshield; }
   const sim::RainState& rain() const { return stepped().rain; }

@@ -82,6 +82,11 @@ constexpr ResourceInfo kResources[] = {
      .name = "lamp map",
      .texture_unit = texture_unit::kLampMap,
      .from_frame = true},
+    // (Its depth at its own unit: RenderSession::Impl::upload_client_image.)
+    {.resource = R::kClientImage,
+     .name = "client image",
+     .texture_unit = texture_unit::kClientImage,
+     .from_frame = true},
 };
 static_assert(std::size(kResources) == kResourceCount);
 constexpr bool in_order() {

@@ -76,4 +76,52 @@ void RenderSession::Impl::upload_road_water(
   road_dry_shown = false;
 }
 
+void RenderSession::Impl::upload_client_image(
+    sim::View view, const std::shared_ptr<const sim::ClientImage>& image) {
+  ClientPicture& c = client[static_cast<std::size_t>(view)];
+  auto make = [](GLenum format, int w, int h, GLenum filter) {
+    Texture t = make_texture_2d(format, w, h);
+    glTextureParameteri(t.id(), GL_TEXTURE_MIN_FILTER, filter);
+    glTextureParameteri(t.id(), GL_TEXTURE_MAG_FILTER, filter);
+    glTextureParameteri(t.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(t.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return t;
+  };
+  const int w = image ? image->width : 1, h = image ? image->height : 1;
+  const bool has_depth = image && !image->depth_m.empty();
+  if (!c.colour.id() || c.width != w || c.height != h) {
+    c.colour = make(GL_RGB8, w, h, GL_LINEAR);
+    c.width = w;
+    c.height = h;
+    c.shown.reset();
+    c.blank_shown = false;
+    c.depth = Texture();
+  }
+  if (!c.depth.id() || c.has_depth != has_depth) {
+    // The depth is read at the nearest texel: a blend of a near and a far one is neither.
+    c.depth = has_depth ? make(GL_R32F, w, h, GL_NEAREST) : make(GL_R32F, 1, 1, GL_NEAREST);
+    c.has_depth = has_depth;
+    c.shown.reset();
+    c.blank_shown = false;
+  }
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  if (!image && !c.blank_shown) {
+    const std::uint8_t black[3] = {0, 0, 0};
+    const float none = 0.0f;
+    glTextureSubImage2D(c.colour.id(), 0, 0, 0, 1, 1, GL_RGB, GL_UNSIGNED_BYTE, black);
+    glTextureSubImage2D(c.depth.id(), 0, 0, 0, 1, 1, GL_RED, GL_FLOAT, &none);
+    c.blank_shown = true;
+  } else if (image && c.shown != image) {
+    glTextureSubImage2D(c.colour.id(), 0, 0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, image->rgb.data());
+    const float none = 0.0f;
+    glTextureSubImage2D(c.depth.id(), 0, 0, 0, has_depth ? w : 1, has_depth ? h : 1, GL_RED,
+                        GL_FLOAT, has_depth ? image->depth_m.data() : &none);
+    c.shown = image;
+    c.blank_shown = false;
+  }
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glBindTextureUnit(texture_unit::kClientImage, c.colour.id());
+  glBindTextureUnit(texture_unit::kClientDepth, c.depth.id());
+}
+
 }  // namespace downpour::render

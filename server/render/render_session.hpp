@@ -32,6 +32,16 @@ struct RenderSession::Impl {
   int road_cells = 0, road_rings = 0;
   std::shared_ptr<const sim::RoadWaterImage> road_shown;
   bool road_dry_shown = false;
+  // Each client-background view's picture and depth on the GPU, and the image they show.
+  struct ClientPicture {
+    Texture colour;  // RGB8, display-encoded
+    Texture depth;   // R32F metres (1x1 0 without one)
+    int width = 0, height = 0;
+    bool has_depth = false;
+    std::shared_ptr<const sim::ClientImage> shown;
+    bool blank_shown = false;
+  };
+  std::array<ClientPicture, sim::kViewCount> client;
 
   // The water surface on the glass brought up to the frame's (a whole upload for each new one:
   // the step publishes one per tick), bound to its texture buffers.
@@ -39,6 +49,9 @@ struct RenderSession::Impl {
   // The road water rings brought up to the frame's: a whole upload for each new image (one per
   // road step: 4 rings of 64 x 64 cells, two half floats each).
   void upload_road_water(const std::shared_ptr<const sim::RoadWaterImage>& image);
+  // A view's client picture brought up to the frame's (black before the first), bound to its
+  // units (kClientImage, kClientDepth).
+  void upload_client_image(sim::View view, const std::shared_ptr<const sim::ClientImage>& image);
 };
 
 }  // namespace downpour::render

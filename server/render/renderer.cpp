@@ -75,6 +75,7 @@ struct Renderer::Impl {
   std::vector<PassTiming> timings;
   std::uint64_t frame = 0;                       // frames rendered, for the transients' use
   std::unique_ptr<RenderSession> image_session;  // render_image's
+  float image_near_m = 0.05f;                    // its camera's near plane
   bool view_drew_relief = false;   // the view's road pass (not the environment's faces)
   std::uint32_t rain_streaks = 0;  // drawn by the last render()
 
@@ -132,12 +133,17 @@ struct Renderer::Impl {
       ff.world = f.world;
       ff.lights = f.lights;
       ff.detail_distance_scale = std::max(face_texel / view_pixel, 1.0f);
+      ff.picture_camera = &f.camera;
       block->upload(ff, water_block(ff, block->view_water().mirror, false));
       apply(RenderState{DepthTest::kOff, true, Blend::kOff});
       glClearNamedFramebufferfv(r.view_fbo, GL_COLOR, 0, black);
       glClearNamedFramebufferfv(r.view_fbo, GL_DEPTH, 0, &zero_depth);
-      for (Pass* pass : passes.environment) {
-        if (world || pass == passes.environment.back()) run_pass(*pass, ff, s, r);  // (the sky)
+      if (f.spec.background == sim::Background::kClient) {
+        for (Pass* pass : passes.client_environment) run_pass(*pass, ff, s, r);
+      } else {
+        for (Pass* pass : passes.environment) {
+          if (world || pass == passes.environment.back()) run_pass(*pass, ff, s, r);  // (the sky)
+        }
       }
       probe.resolve(*environment_programs, face, axes, f.atmosphere,
                     static_cast<int>(lamps->fields().params.w));
@@ -185,6 +191,10 @@ struct Renderer::Impl {
       case Resource::kLampMap:
         texture = passes.lamp_map->texture();
         break;
+      case Resource::kClientImage:
+        session.upload_client_image(f.spec.view,
+                                    f.scene.client_images[static_cast<std::size_t>(f.spec.view)]);
+        return;  // bound to their units there
     }
     glBindTextureUnit(resource_info(res).texture_unit, texture);
   }
@@ -200,8 +210,14 @@ struct Renderer::Impl {
   // For a view of a new size: the transients its passes write, and the spray's CPU buffers, made
   // now rather than when the first water or spray shows (a session's memory is taken when its
   // views are).
+  // The passes of a view: its background's.
+  const std::vector<Pass*>& view_list(const sim::ViewSpec& spec) const {
+    const int v = static_cast<int>(spec.view);
+    return spec.background == sim::Background::kClient ? passes.client_views[v] : passes.views[v];
+  }
+
   void prepare(const FrameContext& f) {
-    const auto& list = passes.views[static_cast<int>(f.spec.view)];
+    const auto& list = view_list(f.spec);
     for (const Pass* pass : list) {
       for (Resource res : pass->decl().writes) {
         const ResourceInfo& info = resource_info(res);
@@ -424,7 +440,9 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
   m.transients.evict();
   m.written.fill(false);
   const int view = static_cast<int>(spec.view);
-  const std::vector<Pass*>& frame_passes = m.passes.frame[view];
+  static const std::vector<Pass*> kNone;
+  const bool client = spec.background == sim::Background::kClient;
+  const std::vector<Pass*>& frame_passes = client ? kNone : m.passes.frame[view];
   const bool reflection =
       lists(frame_passes, m.passes.reflection) && m.passes.reflection->wanted(frame);
   // Profiling: the clears and the frame's uploads finish here, not in the first step's time.
@@ -438,9 +456,9 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
   m.block->upload_view(frame, water_block(frame, mirror, reflection));
   for (Pass* pass : frame_passes)
     m.timed(pass->decl().name, [&] { m.run_pass(*pass, frame, s, resources); });
-  const bool fixed = m.fixed_environment && spec.view == sim::View::kCockpit;
+  const bool fixed = m.fixed_environment && spec.view == sim::View::kCockpit && !client;
   m.passes.rain->take_drawn();
-  for (Pass* pass : fixed ? m.passes.fixed_environment_cockpit : m.passes.views[view]) {
+  for (Pass* pass : fixed ? m.passes.fixed_environment_cockpit : m.view_list(spec)) {
     // The world outside the glass, for the first pass that reads it and has something to draw
     // (it waits for the step, as that pass would).
     const auto& reads = pass->decl().reads;
@@ -532,6 +550,7 @@ std::vector<std::uint8_t> Renderer::render_image(const sim::ViewSpec& spec,
   // A picture of this scene alone: the world outside the glass drawn for it, not a session's
   // earlier ticks.
   if (!impl_->fixed_environment) impl_->image_session->impl_->environment.reset();
+  impl_->image_near_m = make_camera(spec, scene.vehicle, &scene.weather).near_m;
   const PendingReadback pending = render(*impl_->image_session, 0, spec, scene);
   std::vector<std::uint8_t> bottom_up;
   finish(pending, bottom_up);
@@ -541,6 +560,28 @@ std::vector<std::uint8_t> Renderer::render_image(const sim::ViewSpec& spec,
     std::memcpy(&top_down[y * row], &bottom_up[(spec.height - 1 - y) * row], row);
   }
   return top_down;
+}
+
+std::vector<float> Renderer::last_image_depth_m() {
+  if (!impl_->image_session || impl_->image_session->impl_->views.empty() ||
+      !impl_->image_session->impl_->views[0])
+    throw std::logic_error("last_image_depth_m() before render_image()");
+  const ViewTarget& target = *impl_->image_session->impl_->views[0];
+  const int w = target.width, h = target.height;
+  std::vector<float> bottom_up(static_cast<std::size_t>(w) * h);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glGetTextureImage(target.depth.id(), 0, GL_DEPTH_COMPONENT, GL_FLOAT,
+                    static_cast<GLsizei>(bottom_up.size() * sizeof(float)), bottom_up.data());
+  // Reversed-Z with an infinite far plane: depth = near / distance (camera.cpp).
+  const float near = impl_->image_near_m;
+  std::vector<float> out(bottom_up.size());
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const float d = bottom_up[static_cast<std::size_t>(h - 1 - y) * w + x];
+      out[static_cast<std::size_t>(y) * w + x] = d > 0.0f ? near / d : 0.0f;
+    }
+  }
+  return out;
 }
 
 bool box_visible(const glm::mat4& m, const glm::vec3& lo, const glm::vec3& hi) {

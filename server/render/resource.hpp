@@ -36,8 +36,11 @@ enum class Resource : std::uint8_t {
   // (lamp_map_pass.hpp) where the frame has lamps; read weighted by the frame block's lamp_map.x,
   // which is 0 where it was not drawn.
   kLampMap,
+  // A client-background view's picture and its depth (sim::ClientImage), uploaded on first read
+  // where new.
+  kClientImage,
 };
-inline constexpr std::size_t kResourceCount = 12;
+inline constexpr std::size_t kResourceCount = 13;
 
 inline constexpr int kNotTransient = -1;
 inline constexpr int kGlassLayerSize = 0;

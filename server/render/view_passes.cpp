@@ -1,7 +1,9 @@
 #include "server/render/view_passes.hpp"
 
+#include <string>
 #include <utility>
 
+#include "server/render/passes/client_background_pass.hpp"
 #include "server/render/passes/cockpit_pass.hpp"
 #include "server/render/passes/environment_background_pass.hpp"
 #include "server/render/passes/glass_composite_pass.hpp"
@@ -80,12 +82,28 @@ ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
   // mirror), then black, then rain and spray.
   views[static_cast<int>(sim::View::kRain)] =
       then({cockpit, vehicles, street_lights, road, terrain, rain_mask, rain}, spray);
+  // Over a client's picture: the rain, the spray and the glass; the picture holds the world, and in
+  // COCKPIT the cabin.
+  Pass* picture = own(std::make_unique<ClientBackgroundPass>(shared));
+  auto& client = p.client_views;
+  client[cockpit_view] =
+      then(then({picture, rain}, spray), {glass_water_mask, glass_water, glass_composite});
+  client[road_view] = then({picture, rain}, spray);
+  client[static_cast<int>(sim::View::kWindshield)] = {picture, glass_water_mask, glass_water,
+                                                      glass_composite};
+  p.client_environment = {own(std::make_unique<ClientEnvironmentPass>(shared))};
   p.environment = {vehicles, street_lights, road, terrain, sky};
   p.fixed_environment_cockpit = {environment_background, glass_water_mask, glass_water,
                                  glass_composite};
 
   check_pass_order("COCKPIT (fixed environment)", p.fixed_environment_cockpit);
   check_pass_order("environment faces", p.environment);
+  check_pass_order("environment faces from a client's picture", p.client_environment);
+  for (int v = 0; v < sim::kViewCount; ++v) {
+    if (!client[v].empty())
+      check_pass_order(std::string(sim::view_name(static_cast<sim::View>(v))) + " (client's)",
+                       client[v]);
+  }
   for (int v = 0; v < sim::kViewCount; ++v) {
     check_pass_order(sim::view_name(static_cast<sim::View>(v)), views[v]);
     for (const Pass* pass : frame[v]) check_frame_pass(*pass);

@@ -32,6 +32,10 @@ struct ViewPasses {
   // with a fixed environment, COCKPIT's passes (the probe as the background, then the glass).
   std::vector<Pass*> environment;
   std::vector<Pass*> fixed_environment_cockpit;
+  // Per view, where its background is the client's picture (no frame passes): the picture, then
+  // what the server adds over it; and what draws the probe's faces from the picture.
+  std::array<std::vector<Pass*>, sim::kViewCount> client_views;
+  std::vector<Pass*> client_environment;
   // Those the renderer asks or tells something of.
   LampMapPass* lamp_map = nullptr;
   RoadReflectionPass* reflection = nullptr;

@@ -53,6 +53,7 @@ void fill_frame(const session::EncodedFrame& f, std::uint64_t reader_drops, v1::
   road->set_drench(f.stats.road_states[2]);
   road->set_puddle(f.stats.road_states[3]);
   s->set_rain_streaks(f.stats.rain_streaks);
+  s->set_background_repeats(f.stats.background_repeats);
   s->set_visibility_m(f.stats.visibility_m);
   s->set_frames_dropped(reader_drops);
   for (const sim::TireWater& t : f.tires) {
@@ -97,6 +98,8 @@ void fill_session_info(const session::Session& session, v1::SessionInfo* out) {
     if (v.focus_distance_m) spec->set_focus_distance_m(*v.focus_distance_m);
     if (v.aperture_mm) spec->set_aperture_mm(*v.aperture_mm);
     if (v.exposure_s) spec->set_exposure_s(*v.exposure_s);
+    spec->set_background(v.background == sim::Background::kClient ? v1::BACKGROUND_CLIENT
+                                                                  : v1::BACKGROUND_RENDERED);
   }
   out->set_frames_rendered(session.frames_rendered());
   out->set_sim_time_s(session.sim_time_s());

@@ -56,6 +56,7 @@ grpc::ServerUnaryReactor* DownpourService::CreateSession(grpc::CallbackServerCon
                                     "'" + who.name + "' may not create sessions (driver role)"));
   }
   if (context_.draining) return finish(ctx, kDraining);
+  if (auto s = check_request_size(*request, context_.limits); !s.ok()) return finish(ctx, s);
   session::SessionConfig config;
   sim::Update initial;
   if (auto s = to_session_config(*request, context_.limits, &config, &initial); !s.ok())
@@ -121,6 +122,7 @@ grpc::ServerUnaryReactor* DownpourService::Update(grpc::CallbackServerContext* c
                                                   v1::UpdateResponse* response) {
   Principal who;
   if (auto s = context_.auth.authenticate(*ctx, &who); !s.ok()) return finish(ctx, s);
+  if (auto s = check_request_size(*request, context_.limits); !s.ok()) return finish(ctx, s);
   if (auto s = check_session_id(request->session_id(), "session_id"); !s.ok())
     return finish(ctx, s);
   sim::Update update;
@@ -131,6 +133,9 @@ grpc::ServerUnaryReactor* DownpourService::Update(grpc::CallbackServerContext* c
       !s.ok())
     return finish(ctx, s);
   session->touch();
+  if (auto s = to_client_images(request->update(), "update", session->config().views, &update);
+      !s.ok())
+    return finish(ctx, s);
   response->set_sim_time_s(session->sim_time_s());
   return finish(ctx, submit_status(session->post_update(update), session->id()));
 }
@@ -140,6 +145,7 @@ grpc::ServerUnaryReactor* DownpourService::Step(grpc::CallbackServerContext* ctx
                                                 v1::StepResponse* response) {
   Principal who;
   if (auto s = context_.auth.authenticate(*ctx, &who); !s.ok()) return finish(ctx, s);
+  if (auto s = check_request_size(*request, context_.limits); !s.ok()) return finish(ctx, s);
   if (auto s = check_session_id(request->session_id(), "session_id"); !s.ok())
     return finish(ctx, s);
   sim::Update update;
@@ -152,6 +158,9 @@ grpc::ServerUnaryReactor* DownpourService::Step(grpc::CallbackServerContext* ctx
       !s.ok())
     return finish(ctx, s);
   session->touch();
+  if (auto s = to_client_images(request->update(), "update", session->config().views, &update);
+      !s.ok())
+    return finish(ctx, s);
   if (session->config().mode != sim::Mode::kLockstep) {
     return finish(ctx, grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
                                     "session " + session->id() +

@@ -121,6 +121,7 @@ class DriveReactor final : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc
   DriveReactor(DownpourService::Context& ctx, Principal who) : ctx_(ctx), who_(std::move(who)) {}
 
   grpc::Status handle(const v1::DriveRequest& req) {
+    if (auto s = check_request_size(req, ctx_.limits); !s.ok()) return s;
     std::shared_ptr<Session> session;
     {
       std::lock_guard lock(mutex_);
@@ -150,6 +151,9 @@ class DriveReactor final : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc
     session->touch();
     sim::Update update;
     if (auto s = to_update(req.update(), "update", ctx_.limits, &update); !s.ok()) return s;
+    if (auto s = to_client_images(req.update(), "update", session->config().views, &update);
+        !s.ok())
+      return s;
     if (auto s = check_dt(req.dt_s(), "dt_s", true, ctx_.limits); !s.ok()) return s;
     if (!lockstep_ || req.dt_s() == 0.0)
       return submit_status(session->post_update(update), session->id());

@@ -1,10 +1,13 @@
 #include "server/rpc/validation.hpp"
 
+#include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <set>
 #include <sstream>
 
+#include "server/encode/image_decoder.hpp"
 #include "server/sim/vehicle_class.hpp"
 
 namespace downpour::rpc {
@@ -27,6 +30,25 @@ grpc::Status in_range(double v, double lo, double hi, const std::string& field) 
                               number_text(v));
   }
   return grpc::Status::OK;
+}
+
+bool to_view(int in, sim::View* out) {
+  switch (in) {
+    case v1::VIEW_COCKPIT:
+      *out = sim::View::kCockpit;
+      return true;
+    case v1::VIEW_ROAD:
+      *out = sim::View::kRoad;
+      return true;
+    case v1::VIEW_WINDSHIELD:
+      *out = sim::View::kWindshield;
+      return true;
+    case v1::VIEW_RAIN:
+      *out = sim::View::kRain;
+      return true;
+    default:
+      return false;
+  }
 }
 
 #define DP_RETURN_IF_ERROR(expr)         \
@@ -233,23 +255,10 @@ grpc::Status to_update(const v1::Update& in, const std::string& field, const Lim
 
 grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, const Limits& limits,
                           sim::ViewSpec* out) {
-  switch (in.view()) {
-    case v1::VIEW_COCKPIT:
-      out->view = sim::View::kCockpit;
-      break;
-    case v1::VIEW_ROAD:
-      out->view = sim::View::kRoad;
-      break;
-    case v1::VIEW_WINDSHIELD:
-      out->view = sim::View::kWindshield;
-      break;
-    case v1::VIEW_RAIN:
-      out->view = sim::View::kRain;
-      break;
-    default:
-      return invalid(field + ".view",
-                     "must be one of VIEW_COCKPIT, VIEW_ROAD, VIEW_WINDSHIELD, VIEW_RAIN, got " +
-                         std::to_string(in.view()));
+  if (!to_view(in.view(), &out->view)) {
+    return invalid(field + ".view",
+                   "must be one of VIEW_COCKPIT, VIEW_ROAD, VIEW_WINDSHIELD, VIEW_RAIN, got " +
+                       std::to_string(in.view()));
   }
   DP_RETURN_IF_ERROR(in_range(in.width(), 16, limits.max_width, field + ".width"));
   DP_RETURN_IF_ERROR(in_range(in.height(), 16, limits.max_height, field + ".height"));
@@ -286,6 +295,106 @@ grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, cons
   if (in.has_exposure_s()) {
     DP_RETURN_IF_ERROR(in_range(in.exposure_s(), 0.0, 0.25, field + ".exposure_s"));
     out->exposure_s = in.exposure_s();
+  }
+  switch (in.background()) {
+    case v1::BACKGROUND_RENDERED:
+      out->background = sim::Background::kRendered;
+      break;
+    case v1::BACKGROUND_CLIENT:
+      if (out->view == sim::View::kRain)
+        return invalid(field + ".background", "VIEW_RAIN is the rain over black: no background");
+      out->background = sim::Background::kClient;
+      break;
+    default:
+      return invalid(field + ".background",
+                     "must be BACKGROUND_RENDERED or BACKGROUND_CLIENT, got " +
+                         std::to_string(in.background()));
+  }
+  return grpc::Status::OK;
+}
+
+namespace {
+
+// A client image's depth in metres along the view's axis, 0 for the sky or unknown.
+grpc::Status to_depth(const v1::ClientImage& in, const std::string& field, int width, int height,
+                      std::vector<float>* out) {
+  const std::string& bytes = in.depth();
+  try {
+    switch (in.depth_encoding()) {
+      case v1::DEPTH_PNG16_CM: {
+        const encode::Grey16Pixels d = encode::decode_png_grey16(bytes, width, height);
+        out->resize(d.values.size());
+        for (std::size_t i = 0; i < d.values.size(); ++i) (*out)[i] = 0.01f * d.values[i];
+        return grpc::Status::OK;
+      }
+      case v1::DEPTH_CARLA_RGB: {
+        if (!encode::is_png(bytes))
+          return invalid(field + ".depth", "DEPTH_CARLA_RGB must be a PNG (JPEG rounds it)");
+        const encode::RgbPixels d = encode::decode_rgb(bytes, width, height);
+        out->resize(static_cast<std::size_t>(width) * height);
+        for (std::size_t i = 0; i < out->size(); ++i) {
+          const std::uint8_t* p = &d.rgb[i * 3];
+          const std::uint32_t v = p[0] + 256u * p[1] + 65536u * p[2];
+          // Full scale is CARLA's sky.
+          (*out)[i] = v >= 0xfffff0u ? 0.0f : static_cast<float>(1000.0 * v / 16777215.0);
+        }
+        return grpc::Status::OK;
+      }
+      default:
+        return invalid(field + ".depth_encoding",
+                       "a depth needs DEPTH_PNG16_CM or DEPTH_CARLA_RGB, got " +
+                           std::to_string(in.depth_encoding()));
+    }
+  } catch (const encode::DecodeError& e) {
+    return invalid(field + ".depth", e.what());
+  }
+}
+
+std::string view_proto_name(sim::View view) { return "VIEW_" + std::string(sim::view_name(view)); }
+
+}  // namespace
+
+grpc::Status to_client_images(const v1::Update& in, const std::string& field,
+                              const std::vector<sim::ViewSpec>& views, sim::Update* out) {
+  static std::atomic<std::uint64_t> serial{0};
+  sim::ClientImages images{};
+  for (int i = 0; i < in.client_images_size(); ++i) {
+    const v1::ClientImage& c = in.client_images(i);
+    const std::string f = field + ".client_images[" + std::to_string(i) + "]";
+    sim::View view{};
+    const bool known = to_view(c.view(), &view);
+    const auto spec = std::find_if(views.begin(), views.end(),
+                                   [&](const sim::ViewSpec& v) { return known && v.view == view; });
+    if (spec == views.end())
+      return invalid(f + ".view", "the session has no view " + std::to_string(c.view()));
+    const std::string name = view_proto_name(spec->view);
+    if (spec->background != sim::Background::kClient) {
+      return invalid(f + ".view", name +
+                                      " draws the server's world (BACKGROUND_RENDERED): create the "
+                                      "session with its background BACKGROUND_CLIENT to send it "
+                                      "pictures");
+    }
+    const auto v = static_cast<std::size_t>(spec->view);
+    if (images[v]) return invalid(f + ".view", "at most one picture a view in an update");
+    auto image = std::make_shared<sim::ClientImage>();
+    try {
+      encode::RgbPixels rgb = encode::decode_rgb(c.image(), spec->width, spec->height);
+      image->rgb = std::move(rgb.rgb);
+    } catch (const encode::DecodeError& e) {
+      return invalid(f + ".image", e.what());
+    }
+    image->width = spec->width;
+    image->height = spec->height;
+    if (!c.depth().empty()) {
+      DP_RETURN_IF_ERROR(to_depth(c, f, spec->width, spec->height, &image->depth_m));
+    } else if (c.depth_encoding() != v1::DEPTH_ENCODING_UNSPECIFIED) {
+      return invalid(f + ".depth", "empty, but a depth_encoding is given");
+    }
+    image->serial = ++serial;
+    images[v] = std::move(image);
+  }
+  for (std::size_t v = 0; v < images.size(); ++v) {
+    if (images[v]) out->client_images[v] = std::move(images[v]);
   }
   return grpc::Status::OK;
 }
@@ -355,6 +464,7 @@ grpc::Status to_session_config(const v1::CreateSessionRequest& in, const Limits&
   DP_RETURN_IF_ERROR(to_ego(in.ego(), "ego", &c.ego));
   for (sim::ViewSpec& spec : c.views) spec.eye_m = c.ego.eye_m;
   DP_RETURN_IF_ERROR(to_update(in.initial(), "initial", limits, initial));
+  DP_RETURN_IF_ERROR(to_client_images(in.initial(), "initial", c.views, initial));
   *config = std::move(c);
   return grpc::Status::OK;
 }
@@ -365,6 +475,15 @@ grpc::Status check_dt(double dt_s, const std::string& field, bool allow_zero,
   if (!allow_zero && dt_s == 0.0)
     return invalid(field, "must be in (0, " + number_text(limits.max_dt_s) + "], got 0");
   return grpc::Status::OK;
+}
+
+grpc::Status check_request_size(const google::protobuf::Message& request, const Limits& limits) {
+  const std::size_t bytes = request.ByteSizeLong();
+  if (bytes <= limits.max_request_bytes) return grpc::Status::OK;
+  return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                      "request: " + std::to_string(bytes) + " bytes, past the server's limit of " +
+                          std::to_string(limits.max_request_bytes) +
+                          " (its --max-message-mb raises it)");
 }
 
 grpc::Status check_session_id(const std::string& id, const std::string& field) {

@@ -3,6 +3,7 @@
 // field and its allowed range.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include <grpcpp/support/status.h>
@@ -20,10 +21,19 @@ struct Limits {
   int max_views = 4;
   int max_traffic = 64;
   double max_dt_s = 10.0;
+  std::size_t max_request_bytes = std::size_t{1} << 20;  // --max-message-mb
 };
+
+// RESOURCE_EXHAUSTED naming the flag that raises the limit, for a request past it.
+grpc::Status check_request_size(const google::protobuf::Message& request, const Limits& limits);
 
 grpc::Status to_update(const v1::Update& in, const std::string& field, const Limits& limits,
                        sim::Update* out);
+// The update's client images (Update.client_images), each decoded and checked against the session's
+// view it names (which must have a client background): all of them into `out`, or none and the
+// status that says which is wrong and why.
+grpc::Status to_client_images(const v1::Update& in, const std::string& field,
+                              const std::vector<sim::ViewSpec>& views, sim::Update* out);
 grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, const Limits& limits,
                           sim::ViewSpec* out);
 grpc::Status to_session_config(const v1::CreateSessionRequest& in, const Limits& limits,

@@ -23,6 +23,8 @@ struct FrameStats {
   // The visible road in each state of the water model, in RoadState's order (all 0: no road in
   // sight).
   std::array<double, 4> road_states{};
+  // A client-background view: the frames it drew over a picture already drawn, or none yet.
+  std::uint64_t background_repeats = 0;
 };
 
 struct EncodedFrame {

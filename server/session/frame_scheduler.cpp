@@ -72,6 +72,7 @@ struct FrameScheduler::InFlight {
   double view_wet_fraction = 0.0;
   std::array<double, 4> road_states{};
   std::uint32_t rain_streaks = 0;
+  std::uint64_t background_repeats = 0;
   double visibility_m = 0.0;
   std::array<sim::TireWater, sim::kTires> tires{};
   sim::EgoPlace ego_place;
@@ -408,6 +409,10 @@ void FrameScheduler::tick(const std::shared_ptr<Session>& s, const StartedStep& 
           renderer_->render(*targets, static_cast<int>(i), views[i], inputs, water);
       f.render_ms = ms_since(t0);
       f.rain_streaks = renderer_->last_rain_streaks();
+      if (views[i].background == sim::Background::kClient) {
+        f.background_repeats = s->note_background(
+            views[i].view, inputs.client_images[static_cast<std::size_t>(views[i].view)].get());
+      }
       f.visibility_m = visibility_m;
       f.session = s;
       f.collector = collector;
@@ -497,6 +502,7 @@ void FrameScheduler::encode(InFlight f, std::vector<std::uint8_t> pixels, double
     frame->stats.view_wet_fraction = f.view_wet_fraction;
     frame->stats.road_states = f.road_states;
     frame->stats.rain_streaks = f.rain_streaks;
+    frame->stats.background_repeats = f.background_repeats;
     frame->stats.visibility_m = f.visibility_m;
     frame->tires = f.tires;
     frame->ego_place = f.ego_place;

@@ -218,4 +218,14 @@ void Session::publish(const FramePtr& frame) {
   for (const auto& s : sinks) s->on_frame(frame);
 }
 
+std::uint64_t Session::note_background(sim::View view, const sim::ClientImage* image) {
+  const auto v = static_cast<std::size_t>(view);
+  if (!image || image->serial == background_drawn_[v]) {
+    ++background_repeats_[v];
+  } else {
+    background_drawn_[v] = image->serial;
+  }
+  return background_repeats_[v];
+}
+
 }  // namespace downpour::session

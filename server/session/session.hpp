@@ -2,6 +2,7 @@
 // simulation (render thread only) and the readers of its frames.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -105,6 +106,9 @@ class Session {
   void note_sim_time() { sim_time_s_.store(simulation_.state().sim_time_s); }
   void set_tick_stats(const TickStats& stats);
   std::uint64_t steps_cancelled() const { return steps_cancelled_.load(); }
+  // A client-background view drawn over `image` (null: none yet): its repeats so far, this one
+  // counted where the picture is not new to it.
+  std::uint64_t note_background(sim::View view, const sim::ClientImage* image);
 
   // --- encoder threads ---
   void publish(const FramePtr& frame);
@@ -116,6 +120,9 @@ class Session {
   const std::function<void()> wake_renderer_;
   sim::Simulation simulation_;    // render thread only
   std::uint64_t next_frame_ = 1;  // render thread only
+  // Each view's last picture drawn (its serial) and its repeats: render thread only.
+  std::array<std::uint64_t, sim::kViewCount> background_drawn_{};
+  std::array<std::uint64_t, sim::kViewCount> background_repeats_{};
 
   mutable std::mutex mutex_;
   std::deque<StepJob> jobs_;                     // guarded by mutex_

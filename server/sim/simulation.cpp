@@ -81,6 +81,9 @@ void Simulation::apply(const Update& update) {
   if (update.wipers) state_.wipers = *update.wipers;
   if (update.weather) state_.weather = *update.weather;
   if (update.traffic) state_.traffic = *update.traffic;
+  for (int v = 0; v < kViewCount; ++v) {
+    if (update.client_images[v]) state_.client_images[v] = update.client_images[v];
+  }
   resolve_lights(update.vehicle.has_value(), update.traffic.has_value());
 }
 
@@ -150,6 +153,7 @@ SceneState Simulation::inputs_after(double dt_s) const {
   inputs.glass = state_.glass;
   inputs.roads = state_.roads;
   inputs.ego = state_.ego;
+  inputs.client_images = state_.client_images;  // the pictures the views draw over
   // The road's water as the last step left it (it changes over seconds; the step may be running
   // while the road is drawn).
   inputs.road_water = state_.road_water;

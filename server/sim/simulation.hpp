@@ -73,6 +73,9 @@ struct SceneState {
   // brought its own.
   std::shared_ptr<const RoadNetwork> roads;
   EgoGeometry ego;
+  // The latest picture each client-background view was sent (null: none yet). Not part of the
+  // simulation: it only shows behind what the simulation draws.
+  ClientImages client_images{};
 };
 
 class Simulation {

@@ -8,6 +8,9 @@ void Update::merge_from(const Update& later) {
   if (later.wipers) wipers = later.wipers;
   if (later.weather) weather = later.weather;
   if (later.traffic) traffic = later.traffic;
+  for (int v = 0; v < kViewCount; ++v) {
+    if (later.client_images[v]) client_images[v] = later.client_images[v];
+  }
 }
 
 std::string_view view_name(View view) {

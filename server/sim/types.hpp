@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -88,20 +89,35 @@ struct EgoPlace {
 };
 
 // A partial update: what is present is applied, what is absent keeps its value.
+enum class View { kCockpit = 0, kRoad = 1, kWindshield = 2, kRain = 3 };
+inline constexpr int kViewCount = 4;
+std::string_view view_name(View view);
+
+// A client's camera picture for a view whose background is the client's (ViewSpec::background),
+// decoded: what the view draws its rain, spray and glass water over.
+struct ClientImage {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgb;  // display-encoded (sRGB), rows top-down
+  // Along the view's axis (m), rows top-down; 0 = the sky or unknown. Empty: none came with it.
+  std::vector<float> depth_m;
+  std::uint64_t serial = 0;  // a new one each picture decoded (the frames count repeats by it)
+};
+// The picture a view draws over: one per client-background view of the session, replaced as new
+// ones come; shared by copies of the state.
+using ClientImages = std::array<std::shared_ptr<const ClientImage>, kViewCount>;
+
 struct Update {
   double client_time_s = 0.0;
   std::optional<VehicleState> vehicle;
   std::optional<WiperState> wipers;
   std::optional<Weather> weather;
   std::optional<std::vector<TrafficVehicle>> traffic;  // present = replaces the list
+  ClientImages client_images{};                        // present (non-null) = replaces the view's
 
   // Later fields win; used to fold several realtime updates into one before a tick.
   void merge_from(const Update& later);
 };
-
-enum class View { kCockpit = 0, kRoad = 1, kWindshield = 2, kRain = 3 };
-inline constexpr int kViewCount = 4;
-std::string_view view_name(View view);
 
 struct CameraPose {
   glm::dvec3 position_m{0.0};  // vehicle frame
@@ -118,6 +134,8 @@ struct EgoGeometry {
   double track_m = 1.56;               // between the wheels' centres across
   glm::dvec3 eye_m{1.05, 0.37, 1.22};  // the driver's eye: the COCKPIT and RAIN views' camera
 };
+
+enum class Background { kRendered, kClient };
 
 struct ViewSpec {
   View view = View::kCockpit;
@@ -136,6 +154,8 @@ struct ViewSpec {
   std::optional<double> aperture_mm;
   // The exposure (s): a rain streak is a drop's motion during it. Absent: 1/60 s.
   std::optional<double> exposure_s;
+  // What lies behind the rain: the server's world, or the client's pictures (ClientImage).
+  Background background = Background::kRendered;
   // The driver's eye in the vehicle frame (the session's EgoGeometry): where the COCKPIT and RAIN
   // views look from without a camera of their own.
   glm::dvec3 eye_m = EgoGeometry{}.eye_m;

@@ -197,10 +197,14 @@ TEST_F(RoadNetworkTest, InlineOpenDriveIsParsedAndBadInputIsRefusedClearly) {
   v1::RoadNetwork too_long;
   too_long.set_opendrive_xml(long_roads + "</OpenDRIVE>");
   refused(too_long, grpc::StatusCode::INVALID_ARGUMENT, "add up to more than 5000");
-  // Past the message limit (2 MiB here): gRPC's own refusal.
+  // Past the message limit (2 MiB here): refused naming the flag that raises it; and far past it,
+  // gRPC's own refusal.
   v1::RoadNetwork huge;
   huge.set_opendrive_xml(std::string(3 << 20, ' '));
-  refused(huge, grpc::StatusCode::RESOURCE_EXHAUSTED, "");
+  refused(huge, grpc::StatusCode::RESOURCE_EXHAUSTED, "--max-message-mb");
+  v1::RoadNetwork far_past;
+  far_past.set_opendrive_xml(std::string(20 << 20, ' '));
+  refused(far_past, grpc::StatusCode::RESOURCE_EXHAUSTED, "");
   // The server still serves.
   ASSERT_TRUE(create(map("sumo_grid"), car_at(0.0, 1.6, 40.0, 90.0), &info).ok());
   close(info.session_id());

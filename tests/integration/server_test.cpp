@@ -19,6 +19,7 @@
 #include "grpc_health/v1/health.grpc.pb.h"
 #include "tests/integration/requests.hpp"
 #include "tests/integration/server_process.hpp"
+#include "tests/support/png_io.hpp"
 
 namespace downpour::testing {
 namespace {
@@ -77,6 +78,13 @@ struct Decoded {
   int width = 0;
   int height = 0;
   bool ok = false;
+  std::vector<unsigned char> rgb;
+  // The mean of channel c.
+  double mean(int c) const {
+    double sum = 0.0;
+    for (std::size_t i = c; i < rgb.size(); i += 3) sum += rgb[i];
+    return rgb.empty() ? 0.0 : sum / (rgb.size() / 3);
+  }
 };
 
 Decoded decode(const std::string& jpeg) {
@@ -85,8 +93,9 @@ Decoded decode(const std::string& jpeg) {
   int subsamp = 0, colorspace = 0;
   const auto* data = reinterpret_cast<const unsigned char*>(jpeg.data());
   if (tjDecompressHeader3(h, data, jpeg.size(), &d.width, &d.height, &subsamp, &colorspace) == 0) {
-    std::vector<unsigned char> rgb(static_cast<std::size_t>(d.width) * d.height * 3);
-    d.ok = tjDecompress2(h, data, jpeg.size(), rgb.data(), d.width, 0, d.height, TJPF_RGB, 0) == 0;
+    d.rgb.resize(static_cast<std::size_t>(d.width) * d.height * 3);
+    d.ok =
+        tjDecompress2(h, data, jpeg.size(), d.rgb.data(), d.width, 0, d.height, TJPF_RGB, 0) == 0;
   }
   tjDestroy(h);
   return d;
@@ -166,6 +175,84 @@ TEST_F(ServerTest, LockstepStepReturnsDecodableFramesInOrder) {
     EXPECT_EQ(decode(resp.frames(0).jpeg()).width, 160);
     EXPECT_EQ(decode(resp.frames(1).jpeg()).height, 72);
   }
+  close(id);
+}
+
+// A view over the client's pictures: black until the first, then the picture with the rain and the
+// glass over it, repeated (and counted) while none newer comes; a bad picture is refused with a
+// status that says why and changes nothing; one past the message limit names the flag.
+TEST_F(ServerTest, ClientPicturesComeThroughAndBadOnesAreRefused) {
+  v1::ViewSpec cockpit = view(v1::VIEW_COCKPIT, 160, 90);
+  cockpit.set_background(v1::BACKGROUND_CLIENT);
+  const std::string id = create(v1::MODE_LOCKSTEP, {cockpit, view(v1::VIEW_ROAD, 128, 72)});
+  auto step_with = [&](double t, const std::vector<v1::ClientImage>& pictures,
+                       v1::StepResponse* out) {
+    grpc::ClientContext ctx;
+    ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+    v1::StepRequest req;
+    req.set_session_id(id);
+    *req.mutable_update() = drive_update(t);
+    for (const auto& p : pictures) *req.mutable_update()->add_client_images() = p;
+    req.set_dt_s(0.05);
+    return stub->Step(&ctx, req, out);
+  };
+  v1::StepResponse first;
+  ASSERT_TRUE(step_with(0.05, {}, &first).ok());
+  EXPECT_LT(decode(first.frames(0).jpeg()).mean(0), 70.0)
+      << "black (and rain) before the first picture";
+  EXPECT_EQ(first.frames(0).stats().background_repeats(), 1u);
+
+  // A red picture with a wall 20 m away.
+  std::vector<std::uint8_t> red(160 * 90 * 3);
+  for (std::size_t i = 0; i < red.size(); i += 3) red[i] = 200, red[i + 1] = 40, red[i + 2] = 30;
+  v1::ClientImage picture;
+  picture.set_view(v1::VIEW_COCKPIT);
+  picture.set_image(png_bytes_rgb(160, 90, red));
+  picture.set_depth(png_bytes_grey16(160, 90, std::vector<std::uint16_t>(160 * 90, 2000)));
+  picture.set_depth_encoding(v1::DEPTH_PNG16_CM);
+  v1::StepResponse second;
+  const grpc::Status s2 = step_with(0.10, {picture}, &second);
+  ASSERT_TRUE(s2.ok()) << s2.error_message();
+  const Decoded seen = decode(second.frames(0).jpeg());
+  EXPECT_GT(seen.mean(0), 150.0);
+  EXPECT_LT(seen.mean(1), 90.0);
+  EXPECT_EQ(second.frames(0).stats().background_repeats(), 1u);
+  v1::StepResponse third;
+  ASSERT_TRUE(step_with(0.15, {}, &third).ok());
+  EXPECT_GT(decode(third.frames(0).jpeg()).mean(0), 150.0) << "the last picture, repeated";
+  EXPECT_EQ(third.frames(0).stats().background_repeats(), 2u);
+  EXPECT_EQ(third.frames(1).stats().background_repeats(), 0u) << "ROAD draws its own world";
+
+  auto refused = [&](const v1::ClientImage& bad, grpc::StatusCode code, const std::string& says) {
+    grpc::ClientContext ctx;
+    v1::UpdateRequest req;
+    req.set_session_id(id);
+    *req.mutable_update()->add_client_images() = bad;
+    v1::UpdateResponse resp;
+    const grpc::Status s = stub->Update(&ctx, req, &resp);
+    EXPECT_EQ(s.error_code(), code) << s.error_message();
+    EXPECT_NE(s.error_message().find(says), std::string::npos) << s.error_message();
+  };
+  v1::ClientImage small = picture;
+  small.set_image(png_bytes_rgb(80, 45, std::vector<std::uint8_t>(80 * 45 * 3, 255)));
+  refused(small, grpc::StatusCode::INVALID_ARGUMENT, "the PNG is 80x45, the view is 160x90");
+  v1::ClientImage broken = picture;
+  broken.set_image(picture.image().substr(0, 100));
+  refused(broken, grpc::StatusCode::INVALID_ARGUMENT, "update.client_images[0].image");
+  v1::ClientImage road = picture;
+  road.set_view(v1::VIEW_ROAD);
+  refused(road, grpc::StatusCode::INVALID_ARGUMENT, "BACKGROUND_CLIENT");
+  // 2 MiB of noise, past the server's 1 MiB default.
+  v1::ClientImage huge = picture;
+  std::string noise(2u << 20, '\0');
+  for (std::size_t i = 0; i < noise.size(); ++i)
+    noise[i] = static_cast<char>((i * 2654435761u) >> 13);
+  huge.set_image(noise);
+  refused(huge, grpc::StatusCode::RESOURCE_EXHAUSTED, "--max-message-mb");
+  // None of them changed the picture.
+  v1::StepResponse after;
+  ASSERT_TRUE(step_with(0.20, {}, &after).ok());
+  EXPECT_GT(decode(after.frames(0).jpeg()).mean(0), 150.0);
   close(id);
 }
 

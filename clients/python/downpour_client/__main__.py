@@ -6,6 +6,8 @@ print the server's stats.
   downpour-client record SCENARIO.json --out FILE.mp4|.mov|.avi|.mkv|.mjpeg
                          [--frames N | --duration S] [--view COCKPIT] [--width W --height H]
   downpour-client watch SESSION_ID [--views COCKPIT ROAD] [--out DIR] [--frames N] [--json]
+  downpour-client augment FRAMES_DIR OUT_DIR [--rain MM_H] [--speed MPS] [--wipers MODE]
+                          [--depth-dir DIR] [--warmup S] [--fps F] [--fov DEG]
   downpour-client close SESSION_ID
   downpour-client list
   downpour-client stats
@@ -98,6 +100,42 @@ def build_parser():
     watch_parser.add_argument("--json", action="store_true",
                               help="a JSON line per frame instead of a line per tick")
     watch_parser.set_defaults(func=_command("watch"))
+
+    augment_parser = commands.add_parser(
+        "augment", parents=[common], help="rain and a wet windshield over a folder of pictures",
+        description="Creates a lockstep session whose view draws over the client's pictures "
+                    "(BACKGROUND_CLIENT) and steps it once per picture (name order; JPEG or PNG, "
+                    "all of one size, which the view takes), writing each rainy frame as "
+                    "OUT_DIR/<picture's name>.jpg and its stats as JSON lines "
+                    "(OUT_DIR/stats.jsonl). A picture over 900 KiB is sent as a JPEG of quality 95.")
+    augment_parser.add_argument("frames_dir", metavar="FRAMES_DIR")
+    augment_parser.add_argument("out_dir", metavar="OUT_DIR")
+    augment_parser.add_argument("--rain", type=float, default=20.0, metavar="MM_H",
+                                help="rain rate (default 20 mm/h)")
+    augment_parser.add_argument("--speed", type=float, default=25.0, metavar="MPS",
+                                help="the car's speed (default 25 m/s)")
+    augment_parser.add_argument("--wipers", default="LOW",
+                                help="OFF, INTERMITTENT (every 4 s), LOW or HIGH (default LOW)")
+    augment_parser.add_argument("--view", default="COCKPIT",
+                                help="COCKPIT (rain and glass) or WINDSHIELD (the glass alone)")
+    augment_parser.add_argument("--depth-dir", metavar="DIR",
+                                help="a depth PNG per picture, in the same name order")
+    augment_parser.add_argument("--depth-encoding", default="PNG16_CM",
+                                help="PNG16_CM (16-bit grey, centimetres) or CARLA_RGB")
+    augment_parser.add_argument("--fps", type=float, default=30.0,
+                                help="pictures a second of simulated time (default 30)")
+    augment_parser.add_argument("--warmup", type=float, default=0.0, metavar="S",
+                                help="seconds of rain over the first picture before the first "
+                                     "frame (default 0)")
+    augment_parser.add_argument("--fov", type=float, default=0.0, metavar="DEG",
+                                help="the pictures' vertical field of view (default 60)")
+    augment_parser.add_argument("--sun", type=float, default=35.0, metavar="DEG",
+                                help="the sun's altitude (default 35)")
+    augment_parser.add_argument("--cloudiness", type=float, default=0.8)
+    augment_parser.add_argument("--seed", type=int, default=1)
+    augment_parser.add_argument("--quality", type=int, default=92, help="JPEG quality of the "
+                                                                        "frames")
+    augment_parser.set_defaults(func=_command("augment"))
 
     close_parser = commands.add_parser("close", parents=[common], help="close a session")
     close_parser.add_argument("session_id", metavar="SESSION_ID")

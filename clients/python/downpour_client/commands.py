@@ -16,7 +16,8 @@ from downpour.v1 import downpour_pb2 as pb
 
 from .client import DownpourClient
 from .frames import frame_record
-from .messages import enum_name, message_dict, to_view_spec, view_value
+from .messages import (client_image, enum_name, message_dict, to_view_spec, view_value,
+                       wiper_mode_value)
 from .scenario import Scenario
 from .security import security_options
 
@@ -517,4 +518,102 @@ def record(args):
         print(f"{player.summary()} view={enum_name(pb.View, spec.view)} "
               f"size={spec.width}x{spec.height} codec={video.codec} out={args.out} "
               f"stats={stats_path}", flush=True)
+    return 0
+
+
+# A picture is sent as it is up to this size; a larger one (a PNG, as a rule) is sent as a JPEG of
+# quality 95, under the server's default message limit of 1 MiB.
+_PICTURE_BYTES = 900 * 1024
+_PICTURE_SUFFIXES = (".jpg", ".jpeg", ".png")
+
+
+def _picture_files(folder, what):
+    names = sorted(n for n in os.listdir(folder) if n.lower().endswith(_PICTURE_SUFFIXES))
+    if not names:
+        raise ValueError(f"{what}: no .jpg, .jpeg or .png files in {folder}")
+    return [os.path.join(folder, n) for n in names]
+
+
+def _picture_size(path):
+    from PIL import Image  # python3-pil
+    with Image.open(path) as image:
+        return image.size
+
+
+def _picture_bytes(path):
+    with open(path, "rb") as file:
+        data = file.read()
+    if len(data) <= _PICTURE_BYTES:
+        return data
+    import io
+    from PIL import Image
+    with Image.open(io.BytesIO(data)) as image:
+        out = io.BytesIO()
+        image.convert("RGB").save(out, "JPEG", quality=95)
+        return out.getvalue()
+
+
+def augment_update(sim_time_s, x_m, args, picture, depth=None):
+    """The update of one augmented frame: the car at x_m along the built-in track's straight at
+    --speed, the weather and wipers of the command line, and the frame's picture."""
+    update = pb.Update(sim_time_s=sim_time_s)
+    update.vehicle.position_m.x = x_m
+    update.vehicle.position_m.y = -5.25
+    update.vehicle.velocity_mps.x = args.speed
+    update.weather.rain_rate_mm_h = args.rain
+    update.weather.cloudiness = args.cloudiness
+    update.weather.sun_altitude_deg = args.sun
+    update.wipers.mode = wiper_mode_value(args.wipers, "--wipers")
+    if args.wipers.upper().endswith("INTERMITTENT"):
+        update.wipers.interval_s = 4.0
+    update.client_images.append(client_image(args.view, picture, depth, args.depth_encoding))
+    return update
+
+
+def augment(args):
+    """Rain over a folder of pictures: each picture, in name order, the background of one lockstep
+    step of 1 / --fps s; the frames written beside their pictures' names, and their stats as JSON
+    lines (stats.jsonl)."""
+    pictures = _picture_files(args.frames_dir, "FRAMES_DIR")
+    depths = _picture_files(args.depth_dir, "--depth-dir") if args.depth_dir else None
+    if depths is not None and len(depths) != len(pictures):
+        raise ValueError(f"--depth-dir: {len(depths)} depth files for {len(pictures)} pictures")
+    if not args.fps > 0:
+        raise ValueError("--fps: must be > 0")
+    width, height = _picture_size(pictures[0])
+    os.makedirs(args.out_dir, exist_ok=True)
+    spec = pb.ViewSpec(view=view_value(args.view, "--view"), width=width, height=height,
+                       jpeg_quality=args.quality, fov_deg=args.fov,
+                       background=pb.BACKGROUND_CLIENT)
+    dt = 1.0 / args.fps
+    with _connect(args) as client:
+        first = _picture_bytes(pictures[0])
+        first_depth = open(depths[0], "rb").read() if depths else None
+        info = client.create_session([spec], mode="LOCKSTEP", fps=args.fps, seed=args.seed,
+                                     initial=augment_update(0.0, 0.0, args, first, first_depth))
+        print(f"session_id={info.session_id} size={width}x{height}", flush=True)
+        ignore_signals()
+        t = 0.0
+        try:
+            # Rain on the glass before the first frame, over the first picture.
+            for _ in range(int(round(args.warmup * args.fps))):
+                t += dt
+                client.step(info.session_id, dt, augment_update(t, args.speed * t, args, first,
+                                                                first_depth))
+            with open(os.path.join(args.out_dir, "stats.jsonl"), "w", encoding="utf-8") as stats:
+                for i, path in enumerate(pictures):
+                    depth = open(depths[i], "rb").read() if depths else None
+                    t += dt
+                    response = client.step(info.session_id, dt, augment_update(
+                        t, args.speed * t, args, _picture_bytes(path), depth))
+                    frame = response.frames[0]
+                    name = os.path.splitext(os.path.basename(path))[0] + ".jpg"
+                    with open(os.path.join(args.out_dir, name), "wb") as file:
+                        file.write(frame.jpeg)
+                    record = frame_record(frame)
+                    record["picture"] = os.path.basename(path)
+                    stats.write(json.dumps(record, separators=(",", ":")) + "\n")
+        finally:
+            _close_quietly(client, info.session_id)
+    print(f"{len(pictures)} frames in {args.out_dir}", flush=True)
     return 0

@@ -3,7 +3,10 @@
 from downpour.v1 import downpour_pb2 as pb
 from google.protobuf import json_format
 
-_PREFIXES = {"View": "VIEW_", "Mode": "MODE_", "WiperMode": "WIPER_"}
+_PREFIXES = {"View": "VIEW_", "Mode": "MODE_", "WiperMode": "WIPER_",
+             "Background": "BACKGROUND_", "DepthEncoding": "DEPTH_"}
+# Enums whose zero is a value of its own (not "unspecified").
+_ZERO_NAMED = {"Background"}
 
 
 def _enum_value(enum_type, value, field):
@@ -19,10 +22,10 @@ def _enum_value(enum_type, value, field):
         if not name.startswith(prefix):
             name = prefix + name
         number = enum_type.DESCRIPTOR.values_by_name.get(name)
-        if number is not None and number.number != 0:
+        if number is not None and (number.number != 0 or enum_type.DESCRIPTOR.name in _ZERO_NAMED):
             return number.number
-    allowed = ", ".join(enum_name(enum_type, v.number)
-                        for v in enum_type.DESCRIPTOR.values if v.number != 0)
+    allowed = ", ".join(enum_name(enum_type, v.number) for v in enum_type.DESCRIPTOR.values
+                        if v.number != 0 or enum_type.DESCRIPTOR.name in _ZERO_NAMED)
     raise ValueError(f"{field}: unknown value {value!r}, expected one of {allowed}")
 
 
@@ -46,6 +49,25 @@ def wiper_mode_value(value, field="mode"):
     return _enum_value(pb.WiperMode, value, field)
 
 
+def background_value(value, field="background"):
+    return _enum_value(pb.Background, value, field)
+
+
+def depth_encoding_value(value, field="depth_encoding"):
+    return _enum_value(pb.DepthEncoding, value, field)
+
+
+def client_image(view, image, depth=None, depth_encoding="PNG16_CM"):
+    """A ClientImage: a picture (JPEG or PNG bytes, the view's size) for a view whose background is
+    the client's, and optionally its depth (PNG bytes: "PNG16_CM", a 16-bit grey PNG in
+    centimetres, or "CARLA_RGB", CARLA's depth camera's encoding)."""
+    message = pb.ClientImage(view=view_value(view), image=image)
+    if depth is not None:
+        message.depth = depth
+        message.depth_encoding = depth_encoding_value(depth_encoding)
+    return message
+
+
 def vec3(xyz):
     x, y, z = xyz
     return pb.Vec3(x=x, y=y, z=z)
@@ -58,12 +80,13 @@ def rotation(yaw_pitch_roll):
 
 def view_spec(view, width, height, quality=0, fov_deg=0.0, camera_position_m=None,
               camera_rotation_deg=None, focus_distance_m=None, aperture_mm=None,
-              exposure_s=None):
+              exposure_s=None, background=None):
     """A ViewSpec; camera pose (VIEW_ROAD, or a forward camera for VIEW_COCKPIT) as (x, y, z) and (yaw, pitch, roll).
 
     The lens: focus_distance_m (metres) and aperture_mm (aperture diameter, 0 = a pinhole); None
     leaves the field unset, the view's own lens. exposure_s: the shutter time that rain streaks
-    show (None: 1/60 s).
+    show (None: 1/60 s). background: "RENDERED" (None: the server's world) or "CLIENT" (the
+    client's pictures, sent as Update.client_images).
     """
     spec = pb.ViewSpec(view=view_value(view), width=width, height=height,
                        jpeg_quality=quality, fov_deg=fov_deg)
@@ -77,6 +100,8 @@ def view_spec(view, width, height, quality=0, fov_deg=0.0, camera_position_m=Non
         spec.aperture_mm = aperture_mm
     if exposure_s is not None:
         spec.exposure_s = exposure_s
+    if background is not None:
+        spec.background = background_value(background)
     return spec
 
 
@@ -89,7 +114,8 @@ def to_view_spec(value):
                          value.get("jpeg_quality", 0), value.get("fov_deg", 0.0),
                          focus_distance_m=value.get("focus_distance_m"),
                          aperture_mm=value.get("aperture_mm"),
-                         exposure_s=value.get("exposure_s"))
+                         exposure_s=value.get("exposure_s"),
+                         background=value.get("background"))
     return view_spec(*value)
 
 

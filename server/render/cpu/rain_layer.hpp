@@ -63,6 +63,10 @@ struct RainLayerInputs {
   // out of the texels that its box covers on the layer (the convex outline of its corners, at its
   // nearest depth) where the streak is further away than that.
   std::span<const RainOccluder> occluders;
+  // What a client's picture shows behind each texel (client_background.hpp): its distance along
+  // the view's axis in centimetres (rows bottom-up, 0xffff far), hiding the streaks beyond it as
+  // an occluder's outline does. Empty: none.
+  std::span<const std::uint16_t> scene_depth_cm;
   // Per tile of RainLayer::kTile texels (rows bottom-up), what the cabin does to it (CabinTile,
   // cabin_tiles.hpp): the runs leave out the tiles it hides, and put those it reaches into apart.
   // Empty: no cabin (every tile clear).

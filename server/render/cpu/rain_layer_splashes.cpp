@@ -44,7 +44,12 @@ const std::uint16_t* RainLayer::occlude(const RainLayerInputs& in, float sx, flo
                 occluded_.x1 - occluded_.x0, kUntouched);
   }
   occluded_ = Bounds{};
-  if (in.occluders.empty()) return nullptr;
+  const std::size_t texels = static_cast<std::size_t>(width_) * height_;
+  if (in.scene_depth_cm.size() == texels && texels > 0) {
+    std::copy(in.scene_depth_cm.begin(), in.scene_depth_cm.end(), occluder_depth_.begin());
+    occluded_ = Bounds{0, 0, width_, height_};
+  }
+  if (in.occluders.empty()) return occluded_.empty() ? nullptr : occluder_depth_.data();
   for (const RainOccluder& o : in.occluders) {
     // To the camera in double (the world is kilometres wide), then float.
     const glm::mat4 to_camera(glm::dmat4(in.view) * o.to_world);

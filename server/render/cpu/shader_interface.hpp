@@ -54,7 +54,11 @@ namespace downpour::render {
   X(kGlassCells, 21, usamplerBuffer, glass_cells_tex,                                              \
     "per cell of the glass's grid, rows from v = 0: first entry << count bits | count "            \
     "(sim::GlassWaterSurface)")                                                                    \
-  X(kGlassEntries, 22, usamplerBuffer, glass_entries_tex, "the cells' lists of body indices")
+  X(kGlassEntries, 22, usamplerBuffer, glass_entries_tex, "the cells' lists of body indices")      \
+  X(kClientImage, 23, sampler2D, client_image_tex,                                                 \
+    "a client-background view's picture (display-encoded, rows from the top: sample at 1 - v)")    \
+  X(kClientDepth, 24, sampler2D, client_depth_tex,                                                 \
+    "its depth along the view's axis (m), 0 the sky or unknown; rows from the top")
 
 // The per-frame uniform block: X(GLSL type, name, comment). Every field is a vec4 or a mat4, so
 // the C++ struct below has the std140 layout as it is.

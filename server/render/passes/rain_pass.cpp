@@ -8,6 +8,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "server/render/cpu/cabin_tiles.hpp"
+#include "server/render/cpu/client_background.hpp"
 #include "server/render/cpu/light_set.hpp"
 #include "server/render/cpu/shader_interface.hpp"
 #include "server/render/cpu/vehicle_geometry.hpp"
@@ -100,10 +101,13 @@ RainLayerInputs rain_layer_inputs(const FrameContext& frame, int layer_height,
   }
   // The driver sees the rain over the road ahead, not over the bonnet: its box from the glass's
   // foot forward. Seen from outside, the whole ego car.
+  const bool picture = frame.spec.background == sim::Background::kClient;
   if (is_driver_view(frame.spec.view)) {
-    occluders.push_back({in.vehicle_to_world,
-                         glm::vec3(static_cast<float>(body::kCabinFrontX), -0.9f, 0.28f),
-                         glm::vec3(3.65f, 0.9f, hull_top)});
+    // Over a client's picture, the picture says where the bonnet is.
+    if (!picture)
+      occluders.push_back({in.vehicle_to_world,
+                           glm::vec3(static_cast<float>(body::kCabinFrontX), -0.9f, 0.28f),
+                           glm::vec3(3.65f, 0.9f, hull_top)});
   } else {
     add_car(in.vehicle_to_world);
   }
@@ -127,7 +131,16 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
   const int width = (frame.spec.width + kLayerDivisor - 1) / kLayerDivisor;
   const int height = (frame.spec.height + kLayerDivisor - 1) / kLayerDivisor;
   RainLayerInputs in = rain_layer_inputs(frame, height, occluders_, lamps_);
-  if (is_driver_view(frame.spec.view)) in.cabin_tiles = cabin_tiles_for(frame, width, height);
+  if (frame.spec.background == sim::Background::kClient) {
+    // Hidden by what the picture shows nearer; no cabin of ours.
+    picture_layer_depth_cm(
+        frame.scene.client_images[static_cast<std::size_t>(frame.spec.view)].get(),
+        picture_camera(frame.camera), ground_plane(frame.camera, frame.scene.vehicle), width,
+        height, 0xffff, scene_depth_cm_);
+    in.scene_depth_cm = scene_depth_cm_;
+  } else if (is_driver_view(frame.spec.view)) {
+    in.cabin_tiles = cabin_tiles_for(frame, width, height);
+  }
   Sized& sized = this->sized(width, height);
   RainLayer& layer = sized.layer;
   const auto t0 = std::chrono::steady_clock::now();

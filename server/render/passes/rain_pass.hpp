@@ -67,8 +67,9 @@ class RainPass final : public Pass {
   SharedResources& shared_;
   ShaderProgram program_;
   Uniform u_plane_depth_;
-  std::vector<RainOccluder> occluders_;  // this frame's cars, for the layer
-  std::vector<RainLamp> lamps_;          // and its lamps
+  std::vector<RainOccluder> occluders_;        // this frame's cars, for the layer
+  std::vector<RainLamp> lamps_;                // and its lamps
+  std::vector<std::uint16_t> scene_depth_cm_;  // and over a client's picture, its depth
   // The layer's tiles that the cabin hides, per driver's camera (cabin_tiles.hpp), the latest few.
   struct CabinTiles {
     int width = 0, height = 0;

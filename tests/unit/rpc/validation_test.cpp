@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "server/rpc/convert.hpp"
+#include "tests/support/png_io.hpp"
 
 namespace downpour::rpc {
 namespace {
@@ -547,6 +548,140 @@ TEST(ValidationTest, UnknownHeadlightsAreNamed) {
   t.add_traffic()->mutable_state()->mutable_lights()->set_headlights(
       static_cast<v1::Headlights>(-1));
   EXPECT_TRUE(invalid_naming(update(t), "update.traffic[0].state.lights.headlights"));
+}
+
+// A session whose COCKPIT (48 x 20) draws over the client's pictures, and a ROAD view that does
+// not.
+std::vector<sim::ViewSpec> picture_views() {
+  sim::ViewSpec cockpit = sim::view_spec(sim::View::kCockpit, 48, 20);
+  cockpit.background = sim::Background::kClient;
+  return {cockpit, sim::view_spec(sim::View::kRoad, 48, 20)};
+}
+
+std::string grey_png(int width, int height, std::uint8_t level = 128) {
+  return testing::png_bytes_rgb(
+      width, height,
+      std::vector<std::uint8_t>(static_cast<std::size_t>(width) * height * 3, level));
+}
+
+v1::ClientImage* add_picture(v1::Update* u, v1::View view, std::string image) {
+  v1::ClientImage* c = u->add_client_images();
+  c->set_view(view);
+  c->set_image(std::move(image));
+  return c;
+}
+
+TEST(ValidationTest, TheBackgroundIsTakenAndEchoed) {
+  v1::CreateSessionRequest r = good_request();
+  r.mutable_views(0)->set_background(v1::BACKGROUND_CLIENT);
+  session::SessionConfig config;
+  sim::Update initial;
+  ASSERT_TRUE(to_session_config(r, Limits{}, &config, &initial).ok());
+  EXPECT_EQ(config.views[0].background, sim::Background::kClient);
+  r.mutable_views(0)->set_background(static_cast<v1::Background>(7));
+  EXPECT_TRUE(invalid_naming(to_session_config(r, Limits{}, &config, &initial), "background"));
+  v1::CreateSessionRequest rain = good_request();
+  *rain.mutable_views(0) = view(v1::VIEW_RAIN);
+  rain.mutable_views(0)->set_background(v1::BACKGROUND_CLIENT);
+  EXPECT_TRUE(invalid_naming(to_session_config(rain, Limits{}, &config, &initial), "background"));
+}
+
+TEST(ValidationTest, ClientPicturesAreDecodedWithTheirDepth) {
+  v1::Update u;
+  std::vector<std::uint16_t> cm(48 * 20, 250);
+  cm[0] = 0;  // the sky
+  v1::ClientImage* c = add_picture(&u, v1::VIEW_COCKPIT, grey_png(48, 20, 200));
+  c->set_depth(testing::png_bytes_grey16(48, 20, cm));
+  c->set_depth_encoding(v1::DEPTH_PNG16_CM);
+  sim::Update out;
+  ASSERT_TRUE(to_client_images(u, "update", picture_views(), &out).ok());
+  const auto& image = out.client_images[static_cast<int>(sim::View::kCockpit)];
+  ASSERT_TRUE(image);
+  EXPECT_EQ(image->width, 48);
+  EXPECT_EQ(image->rgb.size(), 48u * 20u * 3u);
+  EXPECT_EQ(image->rgb[5], 200);
+  ASSERT_EQ(image->depth_m.size(), 48u * 20u);
+  EXPECT_FLOAT_EQ(image->depth_m[0], 0.0f);
+  EXPECT_FLOAT_EQ(image->depth_m[1], 2.5f);
+  EXPECT_GT(image->serial, 0u);
+  // CARLA's depth camera: (R + 256 G + 65536 B) / (2^24 - 1) of 1000 m; full scale is the sky.
+  v1::Update carla;
+  std::vector<std::uint8_t> encoded(48 * 20 * 3, 0);
+  const std::uint32_t ten_m = 167772;  // 10 m: 0.01 of full scale
+  encoded[3] = ten_m & 0xff, encoded[4] = (ten_m >> 8) & 0xff, encoded[5] = ten_m >> 16;
+  encoded[0] = encoded[1] = encoded[2] = 0xff;
+  v1::ClientImage* d = add_picture(&carla, v1::VIEW_COCKPIT, grey_png(48, 20));
+  d->set_depth(testing::png_bytes_rgb(48, 20, encoded));
+  d->set_depth_encoding(v1::DEPTH_CARLA_RGB);
+  sim::Update out2;
+  ASSERT_TRUE(to_client_images(carla, "update", picture_views(), &out2).ok());
+  const auto& d2 = out2.client_images[static_cast<int>(sim::View::kCockpit)]->depth_m;
+  EXPECT_FLOAT_EQ(d2[0], 0.0f);
+  EXPECT_NEAR(d2[1], 10.0f, 1e-3f);
+  EXPECT_GT(out2.client_images[0]->serial, image->serial);
+}
+
+TEST(ValidationTest, BadClientPicturesAreRefusedNamingWhatIsWrong) {
+  auto refused = [](const v1::Update& u, const std::string& field, const std::string& why) {
+    sim::Update out;
+    const grpc::Status s = to_client_images(u, "update", picture_views(), &out);
+    EXPECT_TRUE(invalid_naming(s, field));
+    EXPECT_NE(s.error_message().find(why), std::string::npos) << s.error_message();
+    for (const auto& image : out.client_images) EXPECT_FALSE(image) << "nothing taken";
+  };
+  {
+    v1::Update u;
+    add_picture(&u, v1::VIEW_COCKPIT, grey_png(64, 20));
+    refused(u, "update.client_images[0].image", "the PNG is 64x20, the view is 48x20");
+  }
+  {
+    v1::Update u;
+    add_picture(&u, v1::VIEW_COCKPIT, "not a picture at all");
+    refused(u, "update.client_images[0].image", "neither a JPEG nor a PNG");
+  }
+  {
+    v1::Update u;  // a good one first: the bad second fails the whole update
+    add_picture(&u, v1::VIEW_COCKPIT, grey_png(48, 20));
+    add_picture(&u, v1::VIEW_ROAD, grey_png(48, 20));
+    refused(u, "update.client_images[1].view", "BACKGROUND_CLIENT");
+  }
+  {
+    v1::Update u;
+    add_picture(&u, v1::VIEW_WINDSHIELD, grey_png(48, 20));
+    refused(u, "update.client_images[0].view", "the session has no view");
+  }
+  {
+    v1::Update u;
+    add_picture(&u, v1::VIEW_COCKPIT, grey_png(48, 20));
+    add_picture(&u, v1::VIEW_COCKPIT, grey_png(48, 20));
+    refused(u, "update.client_images[1].view", "at most one picture a view");
+  }
+  {
+    v1::Update u;
+    v1::ClientImage* c = add_picture(&u, v1::VIEW_COCKPIT, grey_png(48, 20));
+    c->set_depth(testing::png_bytes_grey16(48, 21, std::vector<std::uint16_t>(48 * 21, 1)));
+    c->set_depth_encoding(v1::DEPTH_PNG16_CM);
+    refused(u, "update.client_images[0].depth", "the PNG is 48x21");
+  }
+  {
+    v1::Update u;
+    v1::ClientImage* c = add_picture(&u, v1::VIEW_COCKPIT, grey_png(48, 20));
+    c->set_depth(testing::png_bytes_grey16(48, 20, std::vector<std::uint16_t>(48 * 20, 1)));
+    refused(u, "update.client_images[0].depth_encoding", "DEPTH_PNG16_CM or DEPTH_CARLA_RGB");
+  }
+  {
+    v1::Update u;
+    v1::ClientImage* c = add_picture(&u, v1::VIEW_COCKPIT, grey_png(48, 20));
+    c->set_depth(grey_png(48, 20));
+    c->set_depth_encoding(v1::DEPTH_PNG16_CM);
+    refused(u, "update.client_images[0].depth", "not a 16-bit grey PNG");
+  }
+  {
+    v1::Update u;
+    v1::ClientImage* c = add_picture(&u, v1::VIEW_COCKPIT, grey_png(48, 20));
+    c->set_depth_encoding(v1::DEPTH_CARLA_RGB);
+    refused(u, "update.client_images[0].depth", "empty, but a depth_encoding is given");
+  }
 }
 
 }  // namespace

@@ -1,0 +1,43 @@
+// Pictures from clients (a simulator's camera and depth images), decoded with their size checked
+// before any pixel is: JPEG through TurboJPEG, PNG through libpng. Untrusted bytes: every failure
+// is a DecodeError whose message says what is wrong, in words a client can act on.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string_view>
+#include <vector>
+
+namespace downpour::encode {
+
+class DecodeError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// 8-bit RGB, rows top-down.
+struct RgbPixels {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgb;
+};
+
+// A 16-bit single channel, rows top-down.
+struct Grey16Pixels {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint16_t> values;
+};
+
+// Whether the bytes start as a JPEG or a PNG file does.
+bool is_jpeg(std::string_view bytes);
+bool is_png(std::string_view bytes);
+
+// A JPEG or PNG (grey, RGB, palette, with or without alpha: the alpha is dropped; 16-bit channels
+// are taken to 8) of exactly width x height.
+RgbPixels decode_rgb(std::string_view bytes, int width, int height);
+// A PNG of one 16-bit grey channel (no other kind: a depth must not be rounded or converted), of
+// exactly width x height, its values as stored.
+Grey16Pixels decode_png_grey16(std::string_view bytes, int width, int height);
+
+}  // namespace downpour::encode

@@ -1,0 +1,68 @@
+#include "server/render/passes/client_background_pass.hpp"
+
+#include "server/render/cpu/client_background.hpp"
+#include "server/render/cpu/glass_view.hpp"
+
+namespace downpour::render {
+namespace {
+
+bool picture_has_depth(const FrameContext& f) {
+  const auto& image = f.scene.client_images[static_cast<std::size_t>(f.spec.view)];
+  return image && !image->depth_m.empty();
+}
+
+}  // namespace
+
+ClientBackgroundPass::ClientBackgroundPass(SharedResources& shared)
+    : shared_(shared),
+      program_("fullscreen.vert", "client_background.frag"),
+      u_forward_(program_.uniform("u_forward")),
+      u_right_tan_(program_.uniform("u_right_tan")),
+      u_up_tan_(program_.uniform("u_up_tan")),
+      u_ground_(program_.uniform("u_ground")),
+      u_near_(program_.uniform("u_near")),
+      u_has_depth_(program_.uniform("u_has_depth")) {}
+
+void ClientBackgroundPass::execute(const FrameContext& frame, const FrameResources&) {
+  const PictureCamera c = picture_camera(frame.camera);
+  const GroundPlane g = ground_plane(frame.camera, frame.scene.vehicle);
+  program_.use();
+  u_forward_.set(c.forward);
+  u_right_tan_.set(c.right * c.tan_x);
+  u_up_tan_.set(c.up * c.tan_y);
+  u_ground_.set(glm::vec4(g.normal, g.camera_height_m));
+  u_near_.set(frame.camera.near_m);
+  u_has_depth_.set(picture_has_depth(frame) ? 1 : 0);
+  shared_.fullscreen.draw();
+}
+
+ClientEnvironmentPass::ClientEnvironmentPass(SharedResources& shared)
+    : shared_(shared),
+      program_("fullscreen.vert", "client_environment.frag"),
+      u_forward_(program_.uniform("u_forward")),
+      u_right_(program_.uniform("u_right")),
+      u_up_(program_.uniform("u_up")),
+      u_tan_(program_.uniform("u_tan")),
+      u_ground_(program_.uniform("u_ground")),
+      u_has_depth_(program_.uniform("u_has_depth")),
+      u_glass_depth_(program_.uniform("u_glass_depth")),
+      u_near_(program_.uniform("u_near")) {}
+
+void ClientEnvironmentPass::execute(const FrameContext& frame, const FrameResources&) {
+  // The picture's camera: the view's, not the face's that this draws from.
+  const Camera& view_camera = frame.picture_camera ? *frame.picture_camera : frame.camera;
+  const PictureCamera c = picture_camera(view_camera);
+  const GroundPlane g = ground_plane(view_camera, frame.scene.vehicle);
+  program_.use();
+  u_forward_.set(c.forward);
+  u_right_.set(c.right);
+  u_up_.set(c.up);
+  u_tan_.set(glm::vec2(c.tan_x, c.tan_y));
+  u_glass_depth_.set(GlassView(view_camera, frame.scene.glass, 1).depth_over_image());
+  u_near_.set(view_camera.near_m);
+  u_ground_.set(glm::vec4(g.normal, g.camera_height_m));
+  u_has_depth_.set(picture_has_depth(frame) ? 1 : 0);
+  shared_.fullscreen.draw();
+}
+
+}  // namespace downpour::render

@@ -1,0 +1,49 @@
+#pragma once
+
+#include "server/render/pass.hpp"
+
+namespace downpour::render {
+
+// A view whose background is the client's (sim::Background::kClient): its latest picture as the
+// view's colour, and its depth where it came with one, else the ground under the car (the sky
+// beyond its horizon), so that the passes after it (the rain's composite, the spray, the glass)
+// are hidden by what the picture shows nearer.
+class ClientBackgroundPass final : public Pass {
+ public:
+  explicit ClientBackgroundPass(SharedResources& shared);
+  const PassDecl& decl() const override { return decl_; }
+  void execute(const FrameContext& frame, const FrameResources& resources) override;
+
+ private:
+  const PassDecl decl_{"client_background",
+                       {Resource::kClientImage},
+                       {Resource::kViewColour, Resource::kViewDepth},
+                       {DepthTest::kAlways, true, Blend::kOff}};
+  SharedResources& shared_;
+  ShaderProgram program_;
+  Uniform u_forward_, u_right_tan_, u_up_tan_, u_ground_, u_near_, u_has_depth_;
+};
+
+// An environment probe's face (environment_probe.hpp) from a client-background view's picture:
+// each direction where the picture shows it, the picture's edges extended beyond it (a lens on
+// the glass turns rays to where the camera does not look); the sky where its depth says so, or
+// above the ground's horizon without one (the probe adds the sun there). Where the picture's depth
+// shows its own cabin (nearer than the windshield's plane), the world outside nearest to it
+// towards the picture's centre stands in: a drop looks out, not back into the car.
+class ClientEnvironmentPass final : public Pass {
+ public:
+  explicit ClientEnvironmentPass(SharedResources& shared);
+  const PassDecl& decl() const override { return decl_; }
+  void execute(const FrameContext& frame, const FrameResources& resources) override;
+
+ private:
+  const PassDecl decl_{"client_environment",
+                       {Resource::kClientImage},
+                       {Resource::kViewColour, Resource::kViewDepth},
+                       {DepthTest::kAlways, true, Blend::kOff}};
+  SharedResources& shared_;
+  ShaderProgram program_;
+  Uniform u_forward_, u_right_, u_up_, u_tan_, u_ground_, u_has_depth_, u_glass_depth_, u_near_;
+};
+
+}  // namespace downpour::render
