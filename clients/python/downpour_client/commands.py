@@ -604,9 +604,9 @@ def augment(args):
                 for i, path in enumerate(pictures):
                     depth = open(depths[i], "rb").read() if depths else None
                     t += dt
-                    response = client.step(info.session_id, dt, augment_update(
+                    frames = client.step(info.session_id, dt, augment_update(
                         t, args.speed * t, args, _picture_bytes(path), depth))
-                    frame = response.frames[0]
+                    frame = frames[0]
                     name = os.path.splitext(os.path.basename(path))[0] + ".jpg"
                     with open(os.path.join(args.out_dir, name), "wb") as file:
                         file.write(frame.jpeg)
