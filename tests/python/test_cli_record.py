@@ -1,5 +1,5 @@
 """The command line against the real server ($DOWNPOUR_SERVER): record (lockstep frames into MP4 and
-MJPEG, counted by ffprobe), play's tick counts, watch and close."""
+MJPEG, counted by ffprobe), play's tick counts, watch and close; augment over a folder of pictures."""
 
 import fresh_stubs  # noqa: F401  (first: the gRPC modules of the current contract)
 
@@ -214,6 +214,43 @@ class CommandLineServerTest(unittest.TestCase):
         again = self.cli("close", info.session_id)
         self.assertEqual(again.returncode, 1)
         self.assertIn("NOT_FOUND", again.stderr)
+
+    # augment: rain and the wet glass over a folder of pictures (BACKGROUND_CLIENT).
+
+    def test_augment_writes_a_rainy_frame_per_picture(self):
+        from PIL import Image
+        frames = self.path("pictures")
+        os.makedirs(frames, exist_ok=True)
+        for i, colour in enumerate([(200, 40, 30), (30, 40, 200), (40, 200, 30)]):
+            Image.new("RGB", (160, 90), colour).save(os.path.join(frames, f"f{i}.png"))
+        out = self.path("augmented")
+        result = self.cli("augment", frames, out, "--rain", "30", "--speed", "20",
+                          "--warmup", "0.5", "--fps", "10")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertEqual(sorted(os.listdir(out)), ["f0.jpg", "f1.jpg", "f2.jpg", "stats.jsonl"])
+        # Each frame is its picture with the rain over it: the picture's colour dominates.
+        for i, channel in enumerate([0, 2, 1]):
+            with Image.open(os.path.join(out, f"f{i}.jpg")) as image:
+                self.assertEqual(image.size, (160, 90))
+                means = [sum(band.getdata()) / (160 * 90) for band in image.convert("RGB").split()]
+                self.assertEqual(max(range(3), key=lambda c: means[c]), channel, means)
+        with open(os.path.join(out, "stats.jsonl")) as file:
+            records = [json.loads(line) for line in file]
+        self.assertEqual([r["picture"] for r in records], ["f0.png", "f1.png", "f2.png"])
+        self.assertTrue(all(int(r["stats"].get("background_repeats", 0)) == 0 for r in records))
+        self.assertTrue(all(r["stats"]["rain_streaks"] > 0 for r in records))
+        self.assertEqual(self.session_ids(), [], "the session is closed")
+
+    def test_a_picture_of_another_size_is_refused(self):
+        from PIL import Image
+        frames = self.path("mixed")
+        os.makedirs(frames, exist_ok=True)
+        Image.new("RGB", (160, 90), (9, 9, 9)).save(os.path.join(frames, "a.png"))
+        Image.new("RGB", (100, 90), (9, 9, 9)).save(os.path.join(frames, "b.png"))
+        result = self.cli("augment", frames, self.path("mixed_out"))
+        self.assertEqual(result.returncode, 1)
+        self.assertIn("the PNG is 100x90, the view is 160x90", result.stderr)
+        self.assertEqual(self.session_ids(), [], "the session is closed")
 
 
 if __name__ == "__main__":
