@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/stats.hpp"
+#include "server/encode/image_decoder.hpp"
 #include "server/encode/jpeg_encoder.hpp"
 #include "server/render/renderer.hpp"
 #include "server/session/frame_scheduler.hpp"
@@ -368,8 +369,11 @@ struct Pipeline {
 
 // Frames delivered through the real pipeline, lockstep, keeping `depth` steps in flight (1 =
 // serial: render, then encode, then the next step).
+// `attach`, where given, adds to each step's update what a client sends beside the scene's (its
+// picture), on this thread, as a gRPC call's thread would.
 json measure_pipeline(const sim::Scenario& scenario, const sim::ViewSpec& spec, int frames,
-                      int depth, double warm_s) {
+                      int depth, double warm_s,
+                      const std::function<void(sim::Update&)>& attach = {}) {
   Pipeline pipeline(scenario, {spec}, sim::Mode::kLockstep, warm_s);
   session::Session* s = pipeline.session.get();
 
@@ -390,7 +394,9 @@ json measure_pipeline(const sim::Scenario& scenario, const sim::ViewSpec& spec, 
     ++in_flight;
     lock.unlock();
     const auto submitted = Clock::now();
-    s->submit_step(scenario.at(warm_s + (i + 1) * dt), dt, [&, submitted, i](session::StepOutcome) {
+    sim::Update update = scenario.at(warm_s + (i + 1) * dt);
+    if (attach) attach(update);
+    s->submit_step(std::move(update), dt, [&, submitted, i](session::StepOutcome) {
       std::lock_guard l(m);
       --in_flight;
       if (i >= warmup) latency.push_back(ms_between(submitted, Clock::now()));
@@ -403,6 +409,54 @@ json measure_pipeline(const sim::Scenario& scenario, const sim::ViewSpec& spec, 
   return {{"fps", frames / seconds},
           {"step_latency_ms", median(latency)},
           {"render_ms_median", pipeline.scheduler.stats().render_ms_median}};
+}
+
+// A client-background COCKPIT (issue 29): each lockstep step brings a picture, a JPEG of the
+// scene's own dry COCKPIT frame at the view's size (quality 85, as a simulator's camera might
+// send), decoded on the submitting thread as the server decodes it on the call's. Steps a second
+// with 3 in flight and serially, and the decode's median and share of a step.
+json measure_client_background(const sim::Scenario& scenario, const sim::ViewSpec& rendered,
+                               int frames, double warm_s) {
+  std::string jpeg;
+  {
+    auto renderer = render::Renderer::create(g_renderer);
+    sim::Simulation simulation(scenario.seed, scenario.at(0.0));
+    warm(simulation, scenario, warm_s);
+    sim::SceneState dry = simulation.state();
+    dry.windshield = {};
+    dry.rain.drops.clear();
+    dry.rain.splashes.clear();
+    dry.spray.reset();
+    const std::vector<std::uint8_t> top_down = renderer->render_image(rendered, dry);
+    std::vector<std::uint8_t> bottom_up(top_down.size());
+    const std::size_t row = static_cast<std::size_t>(rendered.width) * 4;
+    for (int y = 0; y < rendered.height; ++y)
+      std::copy_n(&top_down[y * row], row, &bottom_up[(rendered.height - 1 - y) * row]);
+    jpeg = encode::JpegEncoder().encode({bottom_up.data(), rendered.width, rendered.height}, 85);
+  }
+  sim::ViewSpec spec = rendered;
+  spec.background = sim::Background::kClient;
+  std::vector<double> decode_ms;
+  std::uint64_t serial = 0;
+  const auto attach = [&](sim::Update& u) {
+    const auto t0 = Clock::now();
+    encode::RgbPixels rgb = encode::decode_rgb(jpeg, spec.width, spec.height);
+    auto image = std::make_shared<sim::ClientImage>();
+    image->width = spec.width;
+    image->height = spec.height;
+    image->rgb = std::move(rgb.rgb);
+    image->serial = ++serial;
+    u.client_images[static_cast<int>(sim::View::kCockpit)] = std::move(image);
+    decode_ms.push_back(ms_between(t0, Clock::now()));
+  };
+  json j;
+  j["picture_bytes"] = jpeg.size();
+  j["pipelined"] = measure_pipeline(scenario, spec, frames, 3, warm_s, attach);
+  j["serial"] = measure_pipeline(scenario, spec, frames, 1, warm_s, attach);
+  j["decode_ms"] = median(decode_ms);
+  j["decode_share_of_step"] =
+      median(decode_ms) * j["pipelined"]["fps"].get<double>() / 1000.0;
+  return j;
 }
 
 // A realtime session at the scene's rate, fed updates at twice that rate as a driving simulator's
@@ -487,6 +541,10 @@ int main(int argc, char** argv) {
                "only the rain pass at 10,000 and 80,000 streaks (the rain rows of the table)");
   app.add_flag("--wet-road-only", wet_road_only,
                "only the wet road in COCKPIT and ROAD (the wet road's row of the table)");
+  bool client_background = false;
+  app.add_flag("--client-background", client_background,
+               "only COCKPIT over a client's pictures (a JPEG each step) at each size: lockstep "
+               "steps a second and the decode's share");
   CLI11_PARSE(app, argc, argv);
 
   if (check_renderer) {
@@ -511,6 +569,21 @@ int main(int argc, char** argv) {
   out["encoder_threads"] = g_encoder_threads;
   out["hardware_threads"] = std::thread::hardware_concurrency();
   std::map<std::string, json> pass_ms;  // by size
+  if (client_background) {
+    for (const std::string& size : sizes) {
+      int width = 0, height = 0;
+      if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16) {
+        std::fprintf(stderr, "bad size %s\n", size.c_str());
+        return 2;
+      }
+      json r = measure_client_background(
+          scenario, sim::view_spec(sim::View::kCockpit, width, height), frames, warm_s);
+      r["size"] = size;
+      out["client_background"].push_back(r);
+    }
+    std::printf("%s\n", out.dump(2).c_str());
+    return 0;
+  }
   if (rain_only || wet_road_only) sizes.clear();
   for (const std::string& size : sizes) {
     int width = 0, height = 0;

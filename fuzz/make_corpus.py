@@ -65,7 +65,7 @@ def random_length_string(data):
 
 
 def main():
-    for target in ("request", "scenario", "simulation"):
+    for target in ("request", "scenario", "simulation", "image"):
         shutil.rmtree(os.path.join(CORPUS, target), ignore_errors=True)
     for kind, message in requests():
         write("request", bytes([kind]) + message.SerializeToString())
@@ -87,7 +87,36 @@ def main():
     data = bytes([3]) + b"".join(random_length_string(r.SerializeToString()) for r in feed)
     write("simulation", data)
     write("simulation", bytes([0]) + random_length_string(feed[0].SerializeToString()))
+    images()
     return 0
+
+
+def images():
+    """The image fuzzer's seeds: pictures of its view's size (48 x 20) as a client sends them: a
+    PNG and a JPEG for the picture decoder, a 16-bit PNG for the depth decoder, and picture and depth
+    together (the second byte says where the picture ends: 255 * its share)."""
+    import io
+    from PIL import Image  # python3-pil
+    def encoded(image, kind, **options):
+        out = io.BytesIO()
+        image.save(out, kind, **options)
+        return out.getvalue()
+    picture = Image.new("RGB", (48, 20))
+    picture.putdata([(x * 5, y * 12, 90) for y in range(20) for x in range(48)])
+    png = encoded(picture, "PNG")
+    jpeg = encoded(picture, "JPEG", quality=80)
+    depth = Image.new("I;16", (48, 20))
+    depth.putdata([250 + 10 * x for y in range(20) for x in range(48)])
+    depth_png = encoded(depth, "PNG")
+    write("image", bytes([0, 0]) + png)
+    write("image", bytes([0, 0]) + jpeg)
+    write("image", bytes([1, 0]) + depth_png)
+    for picture_bytes in (png, jpeg):
+        both = picture_bytes + depth_png
+        share = round(255 * len(picture_bytes) / len(both))
+        # (the encoding is the second byte modulo 4: 1 is DEPTH_PNG16_CM)
+        share += (1 - share % 4) % 4
+        write("image", bytes([2, min(share, 253)]) + both)
 
 
 if __name__ == "__main__":
