@@ -39,8 +39,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   switch (data[0] % 3) {
     case 0:
       try {
-        const encode::RgbPixels p = encode::decode_rgb(bytes, kW, kH);
-        require(p.width == kW && p.height == kH && p.rgb.size() == std::size_t{kW} * kH * 3);
+        const encode::BgrxPixels p = encode::decode_bgrx(bytes, kW, kH);
+        require(p.width == kW && p.height == kH && p.bgrx.size() == std::size_t{kW} * kH * 4);
       } catch (const encode::DecodeError&) {
       }
       return 0;
@@ -64,7 +64,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (!rpc::to_client_images(update, "update", views(), &out).ok()) return 0;
       const auto& image = out.client_images[static_cast<int>(sim::View::kCockpit)];
       require(image && image->width == kW && image->height == kH);
-      require(image->rgb.size() == std::size_t{kW} * kH * 3);
+      require(image->bgrx.size() == std::size_t{kW} * kH * 4);
       require(image->depth_m.empty() || image->depth_m.size() == std::size_t{kW} * kH);
       for (const float d : image->depth_m) require(std::isfinite(d) && d >= 0.0f);
       return 0;

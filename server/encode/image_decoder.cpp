@@ -21,7 +21,7 @@ void check_size(const char* kind, int w, int h, int width, int height) {
   }
 }
 
-RgbPixels decode_jpeg(std::string_view bytes, int width, int height) {
+BgrxPixels decode_jpeg(std::string_view bytes, int width, int height) {
   std::unique_ptr<void, int (*)(tjhandle)> handle(tjInitDecompress(), &tjDestroy);
   if (!handle) throw std::runtime_error("tjInitDecompress failed");
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
@@ -31,9 +31,9 @@ RgbPixels decode_jpeg(std::string_view bytes, int width, int height) {
     throw DecodeError(std::string("not a JPEG that decodes: ") + tjGetErrorStr2(handle.get()));
   }
   check_size("JPEG", w, h, width, height);
-  RgbPixels out{w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h * 3)};
-  if (tjDecompress2(handle.get(), data, bytes.size(), out.rgb.data(), w, 0, h, TJPF_RGB,
-                    TJFLAG_FASTDCT) != 0 &&
+  BgrxPixels out{w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h * 4)};
+  if (tjDecompress2(handle.get(), data, bytes.size(), out.bgrx.data(), w, 0, h, TJPF_BGRX,
+                    TJFLAG_FASTDCT | TJFLAG_BOTTOMUP) != 0 &&
       tjGetErrorCode(handle.get()) == TJERR_FATAL) {
     throw DecodeError(std::string("the JPEG does not decode: ") + tjGetErrorStr2(handle.get()));
   }
@@ -106,38 +106,42 @@ struct PngReader {
   static void on_warning(png_structp, png_const_charp) {}
 };
 
-// Reads the rows into `out` (rows top-down, `row_bytes` each) once the transforms are set;
+// Reads the rows into `out` (rows bottom-up, `row_bytes` each) once the transforms are set;
 // `rows` is the caller's, made before its setjmp (a longjmp skips the destructors of what is made
 // after).
 void read_rows(PngReader& r, std::vector<png_bytep>& rows, std::uint8_t* out, std::size_t row_bytes,
                int height) {
   rows.resize(height);
-  for (int y = 0; y < height; ++y) rows[y] = out + static_cast<std::size_t>(y) * row_bytes;
+  for (int y = 0; y < height; ++y)
+    rows[y] = out + static_cast<std::size_t>(height - 1 - y) * row_bytes;
   png_read_image(r.png, rows.data());
   png_read_end(r.png, nullptr);
 }
 
-RgbPixels decode_png_rgb(std::string_view bytes, int width, int height) {
+BgrxPixels decode_png_bgrx(std::string_view bytes, int width, int height) {
   PngReader r(bytes);
-  RgbPixels out;
+  BgrxPixels out;
   std::vector<png_bytep> rows;
   // (No object with a destructor is made between the setjmp and a longjmp back to it.)
   if (setjmp(png_jmpbuf(r.png))) r.rethrow();
   const auto [w, h] = r.read_header(width, height, false);
   png_set_expand(r.png);  // palette to RGB, grey under 8 bits to 8, tRNS to alpha
   png_set_strip_16(r.png);
-  png_set_strip_alpha(r.png);
   png_set_gray_to_rgb(r.png);
+  png_set_bgr(r.png);
+  if (!(png_get_color_type(r.png, r.info) & PNG_COLOR_MASK_ALPHA) &&
+      !png_get_valid(r.png, r.info, PNG_INFO_tRNS))
+    png_set_filler(r.png, 0xff, PNG_FILLER_AFTER);
   png_set_interlace_handling(r.png);
   png_read_update_info(r.png, r.info);
-  if (png_get_rowbytes(r.png, r.info) != static_cast<std::size_t>(w) * 3) {
+  if (png_get_rowbytes(r.png, r.info) != static_cast<std::size_t>(w) * 4) {
     r.error = "an unexpected PNG layout";
     r.fail();
   }
   out.width = w;
   out.height = h;
-  out.rgb.resize(static_cast<std::size_t>(w) * h * 3);
-  read_rows(r, rows, out.rgb.data(), static_cast<std::size_t>(w) * 3, h);
+  out.bgrx.resize(static_cast<std::size_t>(w) * h * 4);
+  read_rows(r, rows, out.bgrx.data(), static_cast<std::size_t>(w) * 4, h);
   return out;
 }
 
@@ -153,9 +157,9 @@ bool is_png(std::string_view b) {
   return b.size() >= 8 && std::memcmp(b.data(), kMagic, 8) == 0;
 }
 
-RgbPixels decode_rgb(std::string_view bytes, int width, int height) {
+BgrxPixels decode_bgrx(std::string_view bytes, int width, int height) {
   if (is_jpeg(bytes)) return decode_jpeg(bytes, width, height);
-  if (is_png(bytes)) return decode_png_rgb(bytes, width, height);
+  if (is_png(bytes)) return decode_png_bgrx(bytes, width, height);
   throw DecodeError(bytes.empty() ? "empty" : "neither a JPEG nor a PNG");
 }
 

@@ -15,14 +15,16 @@ class DecodeError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// 8-bit RGB, rows top-down.
-struct RgbPixels {
+// 8-bit colour in the order blue, green, red and a fourth byte (the picture's alpha, or 255), rows
+// bottom-up: as a GPU texture takes it without converting or flipping (llvmpipe uploads RGBA
+// bytes into an RGBA8 texture at about a sixth of the speed: 7 ms against 1.1 at 1280 x 720).
+struct BgrxPixels {
   int width = 0;
   int height = 0;
-  std::vector<std::uint8_t> rgb;
+  std::vector<std::uint8_t> bgrx;
 };
 
-// A 16-bit single channel, rows top-down.
+// A 16-bit single channel, rows bottom-up.
 struct Grey16Pixels {
   int width = 0;
   int height = 0;
@@ -33,9 +35,9 @@ struct Grey16Pixels {
 bool is_jpeg(std::string_view bytes);
 bool is_png(std::string_view bytes);
 
-// A JPEG or PNG (grey, RGB, palette, with or without alpha: the alpha is dropped; 16-bit channels
-// are taken to 8) of exactly width x height.
-RgbPixels decode_rgb(std::string_view bytes, int width, int height);
+// A JPEG or PNG (grey, RGB, palette, with or without alpha; 16-bit channels are taken to 8) of
+// exactly width x height.
+BgrxPixels decode_bgrx(std::string_view bytes, int width, int height);
 // A PNG of one 16-bit grey channel (no other kind: a depth must not be rounded or converted), of
 // exactly width x height, its values as stored.
 Grey16Pixels decode_png_grey16(std::string_view bytes, int width, int height);

@@ -77,6 +77,10 @@ struct FrameResources {
   // Each transient (the glass layer, the road reflection, the spray layer) once the pass that
   // writes it has begun; empty before.
   std::array<FrameTarget, kResourceCount> transients{};
+  // A client-background view's picture (RGBA8) and its depth (the view's reversed-Z, D32F; none
+  // without one), once a pass reads them.
+  TargetTexture client_colour;
+  TargetTexture client_depth;
   const FrameTarget& transient(Resource r) const { return transients[static_cast<std::size_t>(r)]; }
 };
 

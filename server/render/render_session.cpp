@@ -76,8 +76,8 @@ void RenderSession::Impl::upload_road_water(
   road_dry_shown = false;
 }
 
-void RenderSession::Impl::upload_client_image(
-    sim::View view, const std::shared_ptr<const sim::ClientImage>& image) {
+const RenderSession::Impl::ClientPicture& RenderSession::Impl::upload_client_image(
+    sim::View view, const std::shared_ptr<const sim::ClientImage>& image, float near_m) {
   ClientPicture& c = client[static_cast<std::size_t>(view)];
   auto make = [](GLenum format, int w, int h, GLenum filter) {
     Texture t = make_texture_2d(format, w, h);
@@ -90,7 +90,7 @@ void RenderSession::Impl::upload_client_image(
   const int w = image ? image->width : 1, h = image ? image->height : 1;
   const bool has_depth = image && !image->depth_m.empty();
   if (!c.colour.id() || c.width != w || c.height != h) {
-    c.colour = make(GL_RGB8, w, h, GL_LINEAR);
+    c.colour = make(GL_RGBA8, w, h, GL_LINEAR);
     c.width = w;
     c.height = h;
     c.shown.reset();
@@ -99,29 +99,41 @@ void RenderSession::Impl::upload_client_image(
   }
   if (!c.depth.id() || c.has_depth != has_depth) {
     // The depth is read at the nearest texel: a blend of a near and a far one is neither.
-    c.depth = has_depth ? make(GL_R32F, w, h, GL_NEAREST) : make(GL_R32F, 1, 1, GL_NEAREST);
+    c.depth = make(GL_DEPTH_COMPONENT32F, has_depth ? w : 1, has_depth ? h : 1, GL_NEAREST);
     c.has_depth = has_depth;
     c.shown.reset();
     c.blank_shown = false;
   }
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);  // (rows of 4-byte texels and of floats)
   if (!image && !c.blank_shown) {
-    const std::uint8_t black[3] = {0, 0, 0};
+    const std::uint8_t black[4] = {0, 0, 0, 255};
     const float none = 0.0f;
-    glTextureSubImage2D(c.colour.id(), 0, 0, 0, 1, 1, GL_RGB, GL_UNSIGNED_BYTE, black);
-    glTextureSubImage2D(c.depth.id(), 0, 0, 0, 1, 1, GL_RED, GL_FLOAT, &none);
+    glTextureSubImage2D(c.colour.id(), 0, 0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, black);
+    glTextureSubImage2D(c.depth.id(), 0, 0, 0, 1, 1, GL_DEPTH_COMPONENT, GL_FLOAT, &none);
     c.blank_shown = true;
-  } else if (image && c.shown != image) {
-    glTextureSubImage2D(c.colour.id(), 0, 0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, image->rgb.data());
-    const float none = 0.0f;
-    glTextureSubImage2D(c.depth.id(), 0, 0, 0, has_depth ? w : 1, has_depth ? h : 1, GL_RED,
-                        GL_FLOAT, has_depth ? image->depth_m.data() : &none);
+  } else if (image && (c.shown != image || (has_depth && c.near_m != near_m))) {
+    if (c.shown != image)
+      glTextureSubImage2D(c.colour.id(), 0, 0, 0, w, h, GL_BGRA, GL_UNSIGNED_BYTE,
+                          image->bgrx.data());
+    if (has_depth) {
+      c.depth_buffer.resize(image->depth_m.size());
+      for (std::size_t i = 0; i < c.depth_buffer.size(); ++i) {
+        const float z = image->depth_m[i];
+        c.depth_buffer[i] = z > 0.0f ? std::min(near_m / z, 1.0f) : 0.0f;
+      }
+      glTextureSubImage2D(c.depth.id(), 0, 0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT,
+                          c.depth_buffer.data());
+    } else {
+      const float none = 0.0f;
+      glTextureSubImage2D(c.depth.id(), 0, 0, 0, 1, 1, GL_DEPTH_COMPONENT, GL_FLOAT, &none);
+    }
     c.shown = image;
+    c.near_m = near_m;
     c.blank_shown = false;
   }
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glBindTextureUnit(texture_unit::kClientImage, c.colour.id());
   glBindTextureUnit(texture_unit::kClientDepth, c.depth.id());
+  return c;
 }
 
 }  // namespace downpour::render

@@ -34,10 +34,12 @@ struct RenderSession::Impl {
   bool road_dry_shown = false;
   // Each client-background view's picture and depth on the GPU, and the image they show.
   struct ClientPicture {
-    Texture colour;  // RGB8, display-encoded
-    Texture depth;   // R32F metres (1x1 0 without one)
+    Texture colour;  // RGBA8 (its alpha unused), display-encoded, rows bottom-up
+    Texture depth;   // D32F, the view's reversed-Z: near / distance (1x1 0, the sky, without one)
     int width = 0, height = 0;
     bool has_depth = false;
+    float near_m = 0.0f;              // the near plane its depth was made for
+    std::vector<float> depth_buffer;  // the conversion's
     std::shared_ptr<const sim::ClientImage> shown;
     bool blank_shown = false;
   };
@@ -49,9 +51,12 @@ struct RenderSession::Impl {
   // The road water rings brought up to the frame's: a whole upload for each new image (one per
   // road step: 4 rings of 64 x 64 cells, two half floats each).
   void upload_road_water(const std::shared_ptr<const sim::RoadWaterImage>& image);
-  // A view's client picture brought up to the frame's (black before the first), bound to its
-  // units (kClientImage, kClientDepth).
-  void upload_client_image(sim::View view, const std::shared_ptr<const sim::ClientImage>& image);
+  // A view's client picture brought up to the frame's (black before the first), its depth made
+  // reversed-Z for a camera whose near plane is near_m, bound to their units (kClientImage,
+  // kClientDepth).
+  const ClientPicture& upload_client_image(sim::View view,
+                                           const std::shared_ptr<const sim::ClientImage>& image,
+                                           float near_m);
 };
 
 }  // namespace downpour::render

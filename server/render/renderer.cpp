@@ -191,10 +191,17 @@ struct Renderer::Impl {
       case Resource::kLampMap:
         texture = passes.lamp_map->texture();
         break;
-      case Resource::kClientImage:
-        session.upload_client_image(f.spec.view,
-                                    f.scene.client_images[static_cast<std::size_t>(f.spec.view)]);
+      case Resource::kClientImage: {
+        // The picture's depth made the view's reversed-Z with its camera's near plane.
+        const Camera& camera = f.picture_camera ? *f.picture_camera : f.camera;
+        const RenderSession::Impl::ClientPicture& p = session.upload_client_image(
+            f.spec.view, f.scene.client_images[static_cast<std::size_t>(f.spec.view)],
+            camera.near_m);
+        r.client_colour = {p.colour.id(), p.width, p.height};
+        r.client_depth =
+            p.has_depth ? TargetTexture{p.depth.id(), p.width, p.height} : TargetTexture{};
         return;  // bound to their units there
+      }
     }
     glBindTextureUnit(resource_info(res).texture_unit, texture);
   }
@@ -568,19 +575,13 @@ std::vector<float> Renderer::last_image_depth_m() {
     throw std::logic_error("last_image_depth_m() before render_image()");
   const ViewTarget& target = *impl_->image_session->impl_->views[0];
   const int w = target.width, h = target.height;
-  std::vector<float> bottom_up(static_cast<std::size_t>(w) * h);
+  std::vector<float> out(static_cast<std::size_t>(w) * h);
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
   glGetTextureImage(target.depth.id(), 0, GL_DEPTH_COMPONENT, GL_FLOAT,
-                    static_cast<GLsizei>(bottom_up.size() * sizeof(float)), bottom_up.data());
+                    static_cast<GLsizei>(out.size() * sizeof(float)), out.data());
   // Reversed-Z with an infinite far plane: depth = near / distance (camera.cpp).
   const float near = impl_->image_near_m;
-  std::vector<float> out(bottom_up.size());
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      const float d = bottom_up[static_cast<std::size_t>(h - 1 - y) * w + x];
-      out[static_cast<std::size_t>(y) * w + x] = d > 0.0f ? near / d : 0.0f;
-    }
-  }
+  for (float& d : out) d = d > 0.0f ? near / d : 0.0f;
   return out;
 }
 

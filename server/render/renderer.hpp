@@ -118,7 +118,8 @@ class Renderer {
   // tools).
   std::vector<std::uint8_t> render_image(const sim::ViewSpec& spec, const sim::SceneState& scene);
   // The depth of the last render_image's view along its axis (m; 0 where nothing was drawn: the
-  // sky), rows top-down: what a client sends with a picture (sim::ClientImage::depth_m).
+  // sky), rows bottom-up: a client's picture's depth as the server holds it
+  // (sim::ClientImage::depth_m).
   std::vector<float> last_image_depth_m();
 
   // Frees the shared intermediate targets (remade on demand): after sessions close, so that the

@@ -330,11 +330,11 @@ grpc::Status to_depth(const v1::ClientImage& in, const std::string& field, int w
       case v1::DEPTH_CARLA_RGB: {
         if (!encode::is_png(bytes))
           return invalid(field + ".depth", "DEPTH_CARLA_RGB must be a PNG (JPEG rounds it)");
-        const encode::RgbPixels d = encode::decode_rgb(bytes, width, height);
+        const encode::BgrxPixels d = encode::decode_bgrx(bytes, width, height);
         out->resize(static_cast<std::size_t>(width) * height);
         for (std::size_t i = 0; i < out->size(); ++i) {
-          const std::uint8_t* p = &d.rgb[i * 3];
-          const std::uint32_t v = p[0] + 256u * p[1] + 65536u * p[2];
+          const std::uint8_t* p = &d.bgrx[i * 4];
+          const std::uint32_t v = p[2] + 256u * p[1] + 65536u * p[0];  // (B G R X)
           // Full scale is CARLA's sky.
           (*out)[i] = v >= 0xfffff0u ? 0.0f : static_cast<float>(1000.0 * v / 16777215.0);
         }
@@ -378,8 +378,8 @@ grpc::Status to_client_images(const v1::Update& in, const std::string& field,
     if (images[v]) return invalid(f + ".view", "at most one picture a view in an update");
     auto image = std::make_shared<sim::ClientImage>();
     try {
-      encode::RgbPixels rgb = encode::decode_rgb(c.image(), spec->width, spec->height);
-      image->rgb = std::move(rgb.rgb);
+      encode::BgrxPixels bgrx = encode::decode_bgrx(c.image(), spec->width, spec->height);
+      image->bgrx = std::move(bgrx.bgrx);
     } catch (const encode::DecodeError& e) {
       return invalid(f + ".image", e.what());
     }

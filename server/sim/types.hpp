@@ -98,8 +98,10 @@ std::string_view view_name(View view);
 struct ClientImage {
   int width = 0;
   int height = 0;
-  std::vector<std::uint8_t> rgb;  // display-encoded (sRGB), rows top-down
-  // Along the view's axis (m), rows top-down; 0 = the sky or unknown. Empty: none came with it.
+  // Display-encoded (sRGB) blue, green, red and a byte unused, 4 a pixel (a texture takes them
+  // without converting), rows bottom-up (GL's order).
+  std::vector<std::uint8_t> bgrx;
+  // Along the view's axis (m), rows bottom-up; 0 = the sky or unknown. Empty: none came with it.
   std::vector<float> depth_m;
   std::uint64_t serial = 0;  // a new one each picture decoded (the frames count repeats by it)
 };

@@ -27,14 +27,19 @@ sim::ViewSpec picture_view(sim::View view, int width, int height) {
   return spec;
 }
 
-// A rendered frame (RGBA, rows top-down) as a client's picture.
+// A rendered frame (RGBA, rows top-down) as a client's picture (rows bottom-up, as decoded).
 std::shared_ptr<sim::ClientImage> as_picture(const RgbaImage& frame) {
   auto image = std::make_shared<sim::ClientImage>();
   image->width = frame.width;
   image->height = frame.height;
-  image->rgb.resize(static_cast<std::size_t>(frame.width) * frame.height * 3);
-  for (std::size_t i = 0; i < image->rgb.size() / 3; ++i) {
-    for (int c = 0; c < 3; ++c) image->rgb[i * 3 + c] = frame.pixels[i * 4 + c];
+  image->bgrx.resize(frame.pixels.size());
+  const std::size_t row = static_cast<std::size_t>(frame.width) * 4;
+  for (int y = 0; y < frame.height; ++y) {
+    for (std::size_t x = 0; x < row; x += 4) {  // RGBA to BGRX
+      const std::uint8_t* from = &frame.pixels[y * row + x];
+      std::uint8_t* to = &image->bgrx[(frame.height - 1 - y) * row + x];
+      to[0] = from[2], to[1] = from[1], to[2] = from[0], to[3] = 255;
+    }
   }
   static std::uint64_t serial = 0;
   image->serial = ++serial;

@@ -49,9 +49,8 @@ void picture_layer_depth_cm(const sim::ClientImage* image, const PictureCamera& 
   if (image && !image->depth_m.empty() && width > 0 && height > 0) {
     const int w = image->width, h = image->height;
     for (int j = 0; j < height; ++j) {
-      // Layer rows bottom-up, the picture's top-down.
-      const int top = height - 1 - j;
-      const int y0 = top * h / height, y1 = std::max(y0 + 1, (top + 1) * h / height);
+      // Rows bottom-up, in the layer and the picture.
+      const int y0 = j * h / height, y1 = std::max(y0 + 1, (j + 1) * h / height);
       for (int i = 0; i < width; ++i) {
         const int x0 = i * w / width, x1 = std::max(x0 + 1, (i + 1) * w / width);
         float nearest = 0.0f;

@@ -56,9 +56,9 @@ namespace downpour::render {
     "(sim::GlassWaterSurface)")                                                                    \
   X(kGlassEntries, 22, usamplerBuffer, glass_entries_tex, "the cells' lists of body indices")      \
   X(kClientImage, 23, sampler2D, client_image_tex,                                                 \
-    "a client-background view's picture (display-encoded, rows from the top: sample at 1 - v)")    \
+    "a client-background view's picture (display-encoded)")                                        \
   X(kClientDepth, 24, sampler2D, client_depth_tex,                                                 \
-    "its depth along the view's axis (m), 0 the sky or unknown; rows from the top")
+    "its depth, the view's reversed-Z (0 the sky or unknown)")
 
 // The per-frame uniform block: X(GLSL type, name, comment). Every field is a vec4 or a mat4, so
 // the C++ struct below has the std140 layout as it is.

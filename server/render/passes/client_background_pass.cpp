@@ -13,27 +13,16 @@ bool picture_has_depth(const FrameContext& f) {
 
 }  // namespace
 
-ClientBackgroundPass::ClientBackgroundPass(SharedResources& shared)
-    : shared_(shared),
-      program_("fullscreen.vert", "client_background.frag"),
-      u_forward_(program_.uniform("u_forward")),
-      u_right_tan_(program_.uniform("u_right_tan")),
-      u_up_tan_(program_.uniform("u_up_tan")),
-      u_ground_(program_.uniform("u_ground")),
-      u_near_(program_.uniform("u_near")),
-      u_has_depth_(program_.uniform("u_has_depth")) {}
-
-void ClientBackgroundPass::execute(const FrameContext& frame, const FrameResources&) {
-  const PictureCamera c = picture_camera(frame.camera);
-  const GroundPlane g = ground_plane(frame.camera, frame.scene.vehicle);
-  program_.use();
-  u_forward_.set(c.forward);
-  u_right_tan_.set(c.right * c.tan_x);
-  u_up_tan_.set(c.up * c.tan_y);
-  u_ground_.set(glm::vec4(g.normal, g.camera_height_m));
-  u_near_.set(frame.camera.near_m);
-  u_has_depth_.set(picture_has_depth(frame) ? 1 : 0);
-  shared_.fullscreen.draw();
+void ClientBackgroundPass::execute(const FrameContext&, const FrameResources& r) {
+  const TargetTexture& picture = r.client_colour;
+  // (Before the first picture a 1 x 1 black one: the view's clear colour stays.)
+  if (picture.width != r.view_colour.width || picture.height != r.view_colour.height) return;
+  glCopyImageSubData(picture.texture, GL_TEXTURE_2D, 0, 0, 0, 0, r.view_colour.texture,
+                     GL_TEXTURE_2D, 0, 0, 0, 0, picture.width, picture.height, 1);
+  if (r.client_depth.texture) {
+    glCopyImageSubData(r.client_depth.texture, GL_TEXTURE_2D, 0, 0, 0, 0, r.view_depth.texture,
+                       GL_TEXTURE_2D, 0, 0, 0, 0, picture.width, picture.height, 1);
+  }
 }
 
 ClientEnvironmentPass::ClientEnvironmentPass(SharedResources& shared)

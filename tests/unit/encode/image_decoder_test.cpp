@@ -33,6 +33,18 @@ std::vector<std::uint8_t> pattern() {
   return rgb;
 }
 
+// The RGB of BGRX pixels, rows top-down (the decoder's run bottom-up, as GL takes them).
+std::vector<std::uint8_t> rgb_of(const BgrxPixels& p) {
+  std::vector<std::uint8_t> rgb;
+  for (int y = p.height - 1; y >= 0; --y) {
+    for (int x = 0; x < p.width; ++x) {
+      const std::uint8_t* at = &p.bgrx[(static_cast<std::size_t>(y) * p.width + x) * 4];
+      rgb.insert(rgb.end(), {at[2], at[1], at[0]});
+    }
+  }
+  return rgb;
+}
+
 std::string message_of(const std::function<void()>& fn) {
   try {
     fn();
@@ -44,10 +56,10 @@ std::string message_of(const std::function<void()>& fn) {
 
 TEST(ImageDecoderTest, PngRgbDecodesExactly) {
   const std::vector<std::uint8_t> rgb = pattern();
-  const RgbPixels out = decode_rgb(testing::png_bytes_rgb(kW, kH, rgb), kW, kH);
+  const BgrxPixels out = decode_bgrx(testing::png_bytes_rgb(kW, kH, rgb), kW, kH);
   EXPECT_EQ(out.width, kW);
   EXPECT_EQ(out.height, kH);
-  EXPECT_EQ(out.rgb, rgb);
+  EXPECT_EQ(rgb_of(out), rgb);
 }
 
 TEST(ImageDecoderTest, PngWithAlphaLosesItsAlpha) {
@@ -67,7 +79,7 @@ TEST(ImageDecoderTest, PngWithAlphaLosesItsAlpha) {
     for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) bytes.append(buf, n);
     std::fclose(f);
   }
-  EXPECT_EQ(decode_rgb(bytes, kW, kH).rgb, rgb);
+  EXPECT_EQ(rgb_of(decode_bgrx(bytes, kW, kH)), rgb);
 }
 
 TEST(ImageDecoderTest, JpegDecodesClose) {
@@ -85,10 +97,11 @@ TEST(ImageDecoderTest, JpegDecodesClose) {
   JpegEncoder encoder;
   const std::string jpeg = encoder.encode({rgba.data(), kW, kH}, 95);
   ASSERT_TRUE(is_jpeg(jpeg));
-  const RgbPixels out = decode_rgb(jpeg, kW, kH);
-  ASSERT_EQ(out.rgb.size(), rgb.size());
+  const BgrxPixels out = decode_bgrx(jpeg, kW, kH);
+  const std::vector<std::uint8_t> seen = rgb_of(out);
+  ASSERT_EQ(seen.size(), rgb.size());
   double error = 0.0;
-  for (std::size_t i = 0; i < rgb.size(); ++i) error += std::abs(out.rgb[i] - rgb[i]);
+  for (std::size_t i = 0; i < rgb.size(); ++i) error += std::abs(seen[i] - rgb[i]);
   EXPECT_LT(error / rgb.size(), 4.0) << "mean absolute error, levels";
 }
 
@@ -96,12 +109,15 @@ TEST(ImageDecoderTest, Grey16KeepsEveryValue) {
   std::vector<std::uint16_t> depth(static_cast<std::size_t>(kW) * kH);
   for (std::size_t i = 0; i < depth.size(); ++i) depth[i] = static_cast<std::uint16_t>(i * 1361);
   const Grey16Pixels out = decode_png_grey16(testing::png_bytes_grey16(kW, kH, depth), kW, kH);
-  EXPECT_EQ(out.values, depth);
+  for (int y = 0; y < kH; ++y) {  // (rows bottom-up)
+    for (int x = 0; x < kW; ++x)
+      ASSERT_EQ(out.values[static_cast<std::size_t>(kH - 1 - y) * kW + x], depth[y * kW + x]);
+  }
 }
 
 TEST(ImageDecoderTest, TheWrongSizeIsRefusedNamingBoth) {
   const std::string png = testing::png_bytes_rgb(kW, kH, pattern());
-  EXPECT_EQ(message_of([&] { decode_rgb(png, 64, 36); }), "the PNG is 48x20, the view is 64x36");
+  EXPECT_EQ(message_of([&] { decode_bgrx(png, 64, 36); }), "the PNG is 48x20, the view is 64x36");
   const std::vector<std::uint16_t> depth(static_cast<std::size_t>(kW) * kH, 100);
   EXPECT_EQ(
       message_of([&] { decode_png_grey16(testing::png_bytes_grey16(kW, kH, depth), kW + 1, kH); }),
@@ -109,20 +125,20 @@ TEST(ImageDecoderTest, TheWrongSizeIsRefusedNamingBoth) {
 }
 
 TEST(ImageDecoderTest, BadBytesAreRefused) {
-  EXPECT_EQ(message_of([] { decode_rgb("", kW, kH); }), "empty");
-  EXPECT_EQ(message_of([] { decode_rgb("GIF89a....", kW, kH); }), "neither a JPEG nor a PNG");
+  EXPECT_EQ(message_of([] { decode_bgrx("", kW, kH); }), "empty");
+  EXPECT_EQ(message_of([] { decode_bgrx("GIF89a....", kW, kH); }), "neither a JPEG nor a PNG");
   // Cut short, and damaged in the middle.
   const std::string png = testing::png_bytes_rgb(kW, kH, pattern());
   EXPECT_NE(message_of([&] {
-              decode_rgb(png.substr(0, png.size() / 2), kW, kH);
+              decode_bgrx(png.substr(0, png.size() / 2), kW, kH);
             }).find("the PNG does not decode"),
             std::string::npos);
   std::string damaged = png;
   for (std::size_t i = 60; i < damaged.size() - 20; i += 7) damaged[i] = static_cast<char>(0x5a);
-  EXPECT_NE(message_of([&] { decode_rgb(damaged, kW, kH); }).find("does not decode"),
+  EXPECT_NE(message_of([&] { decode_bgrx(damaged, kW, kH); }).find("does not decode"),
             std::string::npos);
   EXPECT_NE(message_of([] {
-              decode_rgb(std::string("\xff\xd8\xff\xe0garbage", 11), kW, kH);
+              decode_bgrx(std::string("\xff\xd8\xff\xe0garbage", 11), kW, kH);
             }).find("JPEG"),
             std::string::npos);
   // A depth must be a 16-bit grey PNG.

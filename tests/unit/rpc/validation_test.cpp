@@ -598,11 +598,14 @@ TEST(ValidationTest, ClientPicturesAreDecodedWithTheirDepth) {
   const auto& image = out.client_images[static_cast<int>(sim::View::kCockpit)];
   ASSERT_TRUE(image);
   EXPECT_EQ(image->width, 48);
-  EXPECT_EQ(image->rgb.size(), 48u * 20u * 3u);
-  EXPECT_EQ(image->rgb[5], 200);
+  EXPECT_EQ(image->bgrx.size(), 48u * 20u * 4u);
+  EXPECT_EQ(image->bgrx[5], 200);
   ASSERT_EQ(image->depth_m.size(), 48u * 20u);
-  EXPECT_FLOAT_EQ(image->depth_m[0], 0.0f);
-  EXPECT_FLOAT_EQ(image->depth_m[1], 2.5f);
+  // (The first pixel of the PNG is the top-left; the server's rows run bottom-up.)
+  const std::size_t top_left = 19u * 48u;
+  EXPECT_FLOAT_EQ(image->depth_m[top_left], 0.0f);
+  EXPECT_FLOAT_EQ(image->depth_m[top_left + 1], 2.5f);
+  EXPECT_FLOAT_EQ(image->depth_m[0], 2.5f);
   EXPECT_GT(image->serial, 0u);
   // CARLA's depth camera: (R + 256 G + 65536 B) / (2^24 - 1) of 1000 m; full scale is the sky.
   v1::Update carla;
@@ -616,8 +619,8 @@ TEST(ValidationTest, ClientPicturesAreDecodedWithTheirDepth) {
   sim::Update out2;
   ASSERT_TRUE(to_client_images(carla, "update", picture_views(), &out2).ok());
   const auto& d2 = out2.client_images[static_cast<int>(sim::View::kCockpit)]->depth_m;
-  EXPECT_FLOAT_EQ(d2[0], 0.0f);
-  EXPECT_NEAR(d2[1], 10.0f, 1e-3f);
+  EXPECT_FLOAT_EQ(d2[top_left], 0.0f);
+  EXPECT_NEAR(d2[top_left + 1], 10.0f, 1e-3f);
   EXPECT_GT(out2.client_images[0]->serial, image->serial);
 }
 
