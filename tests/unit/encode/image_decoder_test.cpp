@@ -1,5 +1,5 @@
-// Client pictures decoded: JPEG and PNG of the view's size to RGB, 16-bit grey PNG depths exactly,
-// and every kind of bad input refused with a message that says what is wrong.
+// Client pictures decoded: JPEG and PNG of the view's size to BGRX rows bottom-up, 16-bit grey PNG
+// depths exactly, and every kind of bad input refused with a message that says what is wrong.
 #include "server/encode/image_decoder.hpp"
 
 #include <cstdio>
@@ -62,7 +62,7 @@ TEST(ImageDecoderTest, PngRgbDecodesExactly) {
   EXPECT_EQ(rgb_of(out), rgb);
 }
 
-TEST(ImageDecoderTest, PngWithAlphaLosesItsAlpha) {
+TEST(ImageDecoderTest, PngWithAlphaKeepsItsColour) {
   testing::RgbaImage rgba{kW, kH, std::vector<std::uint8_t>(static_cast<std::size_t>(kW) * kH * 4)};
   const std::vector<std::uint8_t> rgb = pattern();
   for (std::size_t i = 0; i < rgb.size() / 3; ++i) {
