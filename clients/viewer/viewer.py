@@ -50,6 +50,7 @@ MIN_RATE_SPAN_S = 0.5
 MAX_BODY_BYTES = 64 * 1024  # a POST's JSON body
 FPS_WINDOW_S = 2.0
 RETRY_S = 0.5
+SLOW_REQUEST_S = 2.0
 LIST_PERIOD_S = 1.0
 HISTORY_S = 60.0
 HISTORY_STEP_S = 0.25
@@ -1000,6 +1001,16 @@ class ViewerHandler(BaseHTTPRequestHandler):
 
     def log_message(self, format, *args):
         pass
+
+    def handle_one_request(self):
+        # A request (but a frame's, which waits for the next frame by design) that took longer than
+        # SLOW_REQUEST_S goes to the log: the page's polls and controls should take milliseconds.
+        start = time.monotonic()
+        super().handle_one_request()
+        took = time.monotonic() - start
+        path = (getattr(self, "path", "") or "").split("?", 1)[0]
+        if took > SLOW_REQUEST_S and path and not path.startswith("/frame/"):
+            log(f"slow request: {getattr(self, 'command', '')} {path} took {took:.1f} s")
 
 
 def make_server(frames, port, host="127.0.0.1", directory=None, follower=None, drive=None):

@@ -153,7 +153,15 @@ async function main() {
     Number(document.getElementById("img-road").dataset.frame || 0) > 2), 45_000);
   // The HUD's stats come from the viewer's own watch of the session, which starts after the drive's
   // first frames: as long a wait as for those.
-  await waitFor("the HUD", () => page.$eval("#hud-cockpit", (e) => e.textContent.includes("render")), 45_000);
+  try {
+    await waitFor("the HUD", () => page.$eval("#hud-cockpit", (e) => e.textContent.includes("render")), 45_000);
+  } catch (e) {
+    // What the page and the viewer said, for the log (the viewer's log is kept beside it).
+    log(`the HUD: ${await page.$eval("#hud-cockpit", (el) => el.innerText).catch((x) => x.message)}`);
+    log(`the page's session: ${await page.$eval("#session", (el) => el.innerText).catch((x) => x.message)}`);
+    log(`the viewer's drive: ${JSON.stringify(await json(base + "/api/drive/state.json").catch((x) => x.message))}`);
+    throw e;
+  }
   await page.screenshot({path: path.join(shots, "01-drive-start.png")});
   const cockpit = await page.$("#img-cockpit");
   const frameBefore = Number(await page.$eval("#img-cockpit", (e) => e.dataset.frame));
