@@ -8,7 +8,13 @@
   bounding box's size, its class from its blueprint's base_type and its lamps; CARLA's weather.
 - Lockstep: CARLA in synchronous mode at a fixed delta; world.tick(), then one Step of the same
   length. mapping.py holds the conversions and their reasons.
+- Overlay (CarlaOverlay): CARLA's own RGB and depth cameras, attached where a view's camera is,
+  feed that view as its background (BACKGROUND_CLIENT): Downpour adds the water on the glass, the
+  blades, the rain and the spray to CARLA's pictures.
 """
+
+import io
+import queue
 
 from downpour.v1 import downpour_pb2 as pb
 
@@ -103,8 +109,9 @@ class CarlaBridge:
         return client.create_session(views, mode="LOCKSTEP", seed=seed, initial=self.update(0.0),
                                      roads=road_network(self.world))
 
-    def run_lockstep(self, client, session_id, seconds, dt_s=0.05, on_step=None):
-        """CARLA in synchronous mode at dt_s, each tick one Step; on_step(update, frames)."""
+    def run_lockstep(self, client, session_id, seconds, dt_s=0.05, on_step=None, overlay=None):
+        """CARLA in synchronous mode at dt_s, each tick one Step; on_step(update, frames). With an
+        overlay (CarlaOverlay), each Step carries its cameras' pictures of that tick."""
         settings = self.world.get_settings()
         settings.synchronous_mode = True
         settings.fixed_delta_seconds = dt_s
@@ -113,7 +120,76 @@ class CarlaBridge:
         for k in range(1, steps + 1):
             self.world.tick()
             update = self.update(k * dt_s)
+            if overlay is not None:
+                update.client_images.append(overlay.picture())
             frames = client.step(session_id, dt_s, update)
             if on_step is not None:
                 on_step(update, frames)
         return steps
+
+
+DEFAULT_EYE = ((1.05, 0.37, 1.22), (0.0, 2.0, 0.0))  # the COCKPIT view's default camera
+
+
+class CarlaOverlay:
+    """CARLA's RGB and depth cameras attached to the ego vehicle at a view's camera pose (Downpour's
+    vehicle frame; the driver's eye by default) with the view's size and vertical fov: each tick's
+    pair of pictures as the view's ClientImage (the picture a JPEG, the depth a PNG in CARLA's own
+    encoding, DEPTH_CARLA_RGB). transform(location, rotation) makes a carla.Transform (the carla
+    module is the caller's: this file does not import it). Create the session's view with
+    background BACKGROUND_CLIENT and the same pose and fov."""
+
+    def __init__(self, world, ego, bridge, transform, view="COCKPIT", width=640, height=360,
+                 fov_deg=60.0, pose=DEFAULT_EYE, quality=92):
+        self.view, self.width, self.height, self.quality = view, width, height, quality
+        location, rotation = mapping.camera_from_view(bridge._axle(ego), *pose)
+        library = world.get_blueprint_library()
+        self.sensors, self._queues = [], []
+        for kind in ("sensor.camera.rgb", "sensor.camera.depth"):
+            blueprint = library.find(kind)
+            blueprint.set_attribute("image_size_x", str(width))
+            blueprint.set_attribute("image_size_y", str(height))
+            blueprint.set_attribute("fov", str(mapping.horizontal_fov_deg(fov_deg, width, height)))
+            sensor = world.spawn_actor(blueprint, transform(location, rotation), attach_to=ego)
+            pictures = queue.Queue()
+            sensor.listen(pictures.put)
+            self.sensors.append(sensor)
+            self._queues.append(pictures)
+
+    def _image(self, pictures, mode, kind, **options):
+        """The newest picture a camera has given, as PNG or JPEG bytes (CARLA's raw_data is BGRA)."""
+        from PIL import Image  # python3-pil
+        image = pictures.get(timeout=10.0)
+        while not pictures.empty():
+            image = pictures.get_nowait()
+        if (image.width, image.height) != (self.width, self.height):
+            raise ValueError(f"CARLA gave a {image.width}x{image.height} picture for a "
+                             f"{self.width}x{self.height} view")
+        rgb = Image.frombuffer("RGBA", (image.width, image.height), bytes(image.raw_data), "raw",
+                               "BGRA", 0, 1).convert(mode)
+        out = io.BytesIO()
+        rgb.save(out, kind, **options)
+        return out.getvalue()
+
+    def picture(self):
+        """This tick's pictures (after world.tick()) as the view's ClientImage."""
+        colour = self._image(self._queues[0], "RGB", "JPEG", quality=self.quality)
+        depth = self._image(self._queues[1], "RGB", "PNG")
+        return pb.ClientImage(view=pb.View.Value("VIEW_" + self.view), image=colour, depth=depth,
+                              depth_encoding=pb.DEPTH_CARLA_RGB)
+
+    def view_spec(self, fov_deg=60.0, pose=DEFAULT_EYE):
+        """The session's ViewSpec for these cameras."""
+        spec = pb.ViewSpec(view=pb.View.Value("VIEW_" + self.view), width=self.width,
+                           height=self.height, fov_deg=fov_deg, background=pb.BACKGROUND_CLIENT)
+        if pose is not DEFAULT_EYE:
+            (spec.camera_position_m.x, spec.camera_position_m.y,
+             spec.camera_position_m.z) = pose[0]
+            (spec.camera_rotation.yaw_deg, spec.camera_rotation.pitch_deg,
+             spec.camera_rotation.roll_deg) = pose[1]
+        return spec
+
+    def destroy(self):
+        for sensor in self.sensors:
+            sensor.stop()
+            sensor.destroy()

@@ -142,3 +142,20 @@ def vehicle_class(base_type, number_of_wheels=4):
     if kind in ("motorcycle", "bicycle") or number_of_wheels == 2:
         return "motorbike"
     return "car"
+
+
+def camera_from_view(axle_local, position_m, rotation_deg):
+    """Where a CARLA camera attached to the vehicle must sit to take a view's pictures: the view's
+    camera pose (Downpour's vehicle frame from the rear axle's ground point: x forward, y left, z
+    up; yaw left, pitch nose down, roll right down) as a location in the actor's CARLA frame
+    (forward, right, up, metres) and a rotator (pitch up, yaw right, roll)."""
+    x, y, z = position_m
+    yaw, pitch, roll = rotation_deg
+    location = (axle_local[0] + x, axle_local[1] - y, axle_local[2] + z)
+    return location, (-pitch, -yaw, roll)
+
+
+def horizontal_fov_deg(vertical_fov_deg, width, height):
+    """CARLA's camera fov (horizontal) for a view's vertical fov at width x height."""
+    half = math.radians(vertical_fov_deg) / 2.0
+    return math.degrees(2.0 * math.atan(math.tan(half) * width / height))

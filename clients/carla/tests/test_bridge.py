@@ -8,7 +8,7 @@ import downpour_client  # noqa: F401  (puts the generated stubs on the path)
 from downpour.v1 import downpour_pb2 as pb
 
 from downpour_carla import mapping
-from downpour_carla.bridge import CarlaBridge
+from downpour_carla.bridge import CarlaBridge, CarlaOverlay
 
 XODR = "<OpenDRIVE><header revMajor=\"1\" revMinor=\"4\"/></OpenDRIVE>"
 
@@ -77,6 +77,52 @@ class World:
 
     def tick(self):
         self.ticks += 1
+        for sensor in getattr(self, "sensors", []):
+            sensor.shoot()
+
+    def get_blueprint_library(self):
+        return types.SimpleNamespace(find=lambda kind: Blueprint(kind))
+
+    def spawn_actor(self, blueprint, transform, attach_to=None):
+        sensor = Sensor(blueprint, transform, attach_to)
+        self.sensors = getattr(self, "sensors", []) + [sensor]
+        return sensor
+
+
+class Blueprint:
+    def __init__(self, kind):
+        self.kind, self.attributes = kind, {}
+
+    def set_attribute(self, name, value):
+        self.attributes[name] = value
+
+
+# What the stand-in's cameras see: CARLA's raw BGRA, a red picture and everything 10 m away
+# (0.01 of the depth camera's 1000 m: 167772 in its 24-bit encoding).
+RED_BGRA = bytes([30, 40, 200, 255])
+TEN_M = 167772
+TEN_M_BGRA = bytes([(TEN_M >> 16) & 0xff, (TEN_M >> 8) & 0xff, TEN_M & 0xff, 255])
+
+
+class Sensor:
+    def __init__(self, blueprint, transform, parent):
+        self.blueprint, self.transform, self.parent = blueprint, transform, parent
+        self.callback, self.destroyed = None, False
+
+    def listen(self, callback):
+        self.callback = callback
+
+    def shoot(self):
+        w = int(self.blueprint.attributes["image_size_x"])
+        h = int(self.blueprint.attributes["image_size_y"])
+        pixel = RED_BGRA if self.blueprint.kind.endswith("rgb") else TEN_M_BGRA
+        self.callback(types.SimpleNamespace(width=w, height=h, raw_data=pixel * (w * h)))
+
+    def stop(self):
+        self.callback = None
+
+    def destroy(self):
+        self.destroyed = True
 
 
 class Client:
@@ -145,6 +191,53 @@ class BridgeTest(unittest.TestCase):
         self.assertEqual(self.world.ticks, 3)
         self.assertEqual([round(u.sim_time_s, 9) for _, _, u in client.steps], [0.05, 0.1, 0.15])
         self.assertTrue(all(dt == 0.05 for _, dt, _ in client.steps))
+
+
+class OverlayTest(unittest.TestCase):
+    """CARLA's cameras at the view's camera feed the view's pictures, every Step."""
+
+    def test_each_step_carries_the_cameras_pictures(self):
+        import io
+        from PIL import Image
+        ego = Vehicle(7, (10.0, 5.0, 0.0), 0.0)
+        world = World([ego])
+        bridge = CarlaBridge(world, ego)
+        overlay = CarlaOverlay(world, ego, bridge, lambda loc, rot: (loc, rot), width=320,
+                               height=180)
+        # At the driver's eye: 1.05 m ahead of the rear axle (1.4 m behind the origin), 0.37 m to
+        # the left (CARLA's -y), 1.22 m up; pitched 2 degrees down (CARLA's -2); CARLA's fov is
+        # horizontal.
+        rgb, depth = world.sensors
+        (x, y, z), (pitch, yaw, roll) = rgb.transform
+        self.assertAlmostEqual(x, -1.4 + 1.05)
+        self.assertAlmostEqual(y, -0.37)
+        self.assertAlmostEqual(z, 1.22)
+        self.assertEqual((pitch, yaw, roll), (-2.0, -0.0, 0.0))
+        self.assertAlmostEqual(float(rgb.blueprint.attributes["fov"]), 91.49, places=1)
+        self.assertIs(rgb.parent, ego)
+        self.assertEqual(depth.blueprint.kind, "sensor.camera.depth")
+        client = Client()
+        bridge.run_lockstep(client, "s1", 0.1, dt_s=0.05, overlay=overlay)
+        self.assertEqual(len(client.steps), 2)
+        for _, _, update in client.steps:
+            self.assertEqual(len(update.client_images), 1)
+            picture = update.client_images[0]
+            self.assertEqual(picture.view, pb.VIEW_COCKPIT)
+            self.assertEqual(picture.depth_encoding, pb.DEPTH_CARLA_RGB)
+            with Image.open(io.BytesIO(picture.image)) as image:
+                self.assertEqual((image.format, image.size), ("JPEG", (320, 180)))
+                r, g, b = image.convert("RGB").getpixel((160, 90))
+                self.assertGreater(r, 180)
+                self.assertLess(b, 60)
+            with Image.open(io.BytesIO(picture.depth)) as image:
+                self.assertEqual((image.format, image.size), ("PNG", (320, 180)))
+                r, g, b = image.convert("RGB").getpixel((5, 5))
+                self.assertEqual(r + 256 * g + 65536 * b, TEN_M)
+        spec = overlay.view_spec()
+        self.assertEqual(spec.background, pb.BACKGROUND_CLIENT)
+        self.assertEqual((spec.width, spec.height), (320, 180))
+        overlay.destroy()
+        self.assertTrue(all(s.destroyed for s in world.sensors))
 
 
 if __name__ == "__main__":
