@@ -272,9 +272,13 @@ grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, cons
   }
   out->fov_deg = in.fov_deg();
   if (in.has_camera_position_m() || in.has_camera_rotation()) {
-    if (out->view != sim::View::kRoad && out->view != sim::View::kCockpit) {
+    // (WINDSHIELD over a client's pictures looks through the glass from the pictures' camera.)
+    const bool picture_windshield =
+        out->view == sim::View::kWindshield && in.background() == v1::BACKGROUND_CLIENT;
+    if (out->view != sim::View::kRoad && out->view != sim::View::kCockpit && !picture_windshield) {
       return invalid(field + ".camera_position_m",
-                     "a camera pose is for VIEW_ROAD and VIEW_COCKPIT only");
+                     "a camera pose is for VIEW_ROAD, VIEW_COCKPIT and a VIEW_WINDSHIELD whose "
+                     "background is BACKGROUND_CLIENT");
     }
     sim::CameraPose pose;
     DP_RETURN_IF_ERROR(

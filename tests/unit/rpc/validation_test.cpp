@@ -571,6 +571,20 @@ v1::ClientImage* add_picture(v1::Update* u, v1::View view, std::string image) {
   return c;
 }
 
+TEST(ValidationTest, AWindshieldOverPicturesTakesTheirCamerasPose) {
+  v1::CreateSessionRequest r = good_request();
+  *r.mutable_views(0) = view(v1::VIEW_WINDSHIELD);
+  r.mutable_views(0)->mutable_camera_position_m()->set_x(1.5);
+  session::SessionConfig config;
+  sim::Update initial;
+  EXPECT_TRUE(invalid_naming(to_session_config(r, Limits{}, &config, &initial),
+                             "views[0].camera_position_m"));
+  r.mutable_views(0)->set_background(v1::BACKGROUND_CLIENT);
+  ASSERT_TRUE(to_session_config(r, Limits{}, &config, &initial).ok());
+  ASSERT_TRUE(config.views[0].camera.has_value());
+  EXPECT_DOUBLE_EQ(config.views[0].camera->position_m.x, 1.5);
+}
+
 TEST(ValidationTest, TheBackgroundIsTakenAndEchoed) {
   v1::CreateSessionRequest r = good_request();
   r.mutable_views(0)->set_background(v1::BACKGROUND_CLIENT);
