@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <utility>
 
+#include "server/render/cpu/camera.hpp"
 #include "server/render/cpu/shader_interface.hpp"
 
 namespace downpour::render {
@@ -117,10 +118,8 @@ const RenderSession::Impl::ClientPicture& RenderSession::Impl::upload_client_ima
                           image->bgrx.data());
     if (has_depth) {
       c.depth_buffer.resize(image->depth_m.size());
-      for (std::size_t i = 0; i < c.depth_buffer.size(); ++i) {
-        const float z = image->depth_m[i];
-        c.depth_buffer[i] = z > 0.0f ? std::min(near_m / z, 1.0f) : 0.0f;
-      }
+      for (std::size_t i = 0; i < c.depth_buffer.size(); ++i)
+        c.depth_buffer[i] = reversed_z(near_m, image->depth_m[i]);
       glTextureSubImage2D(c.depth.id(), 0, 0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT,
                           c.depth_buffer.data());
     } else {

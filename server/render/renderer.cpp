@@ -579,9 +579,7 @@ std::vector<float> Renderer::last_image_depth_m() {
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
   glGetTextureImage(target.depth.id(), 0, GL_DEPTH_COMPONENT, GL_FLOAT,
                     static_cast<GLsizei>(out.size() * sizeof(float)), out.data());
-  // Reversed-Z with an infinite far plane: depth = near / distance (camera.cpp).
-  const float near = impl_->image_near_m;
-  for (float& d : out) d = d > 0.0f ? near / d : 0.0f;
+  for (float& d : out) d = distance_from_reversed_z(impl_->image_near_m, d);
   return out;
 }
 

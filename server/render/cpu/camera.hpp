@@ -26,6 +26,16 @@ struct Camera {
   double aperture_mm = 4.0;
 };
 
+// The depth buffer's value for a point at `distance_m` along the view's axis, with the projection's
+// reversed Z and infinite far plane (make_camera): near / distance, 1 at the near plane, 0 at
+// infinity; and back. A distance of 0 stands for the sky (depth 0) both ways.
+inline float reversed_z(float near_m, float distance_m) {
+  return distance_m > 0.0f ? (distance_m > near_m ? near_m / distance_m : 1.0f) : 0.0f;
+}
+inline float distance_from_reversed_z(float near_m, float depth) {
+  return depth > 0.0f ? near_m / depth : 0.0f;
+}
+
 // Default poses and fields of view, vehicle frame.
 sim::CameraPose default_camera_pose(sim::View view,
                                     const glm::dvec3& eye_m = sim::EgoGeometry{}.eye_m);

@@ -132,11 +132,18 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
   const int height = (frame.spec.height + kLayerDivisor - 1) / kLayerDivisor;
   RainLayerInputs in = rain_layer_inputs(frame, height, occluders_, lamps_);
   if (frame.spec.background == sim::Background::kClient) {
-    // Hidden by what the picture shows nearer; no cabin of ours.
-    picture_layer_depth_cm(
-        frame.scene.client_images[static_cast<std::size_t>(frame.spec.view)].get(),
-        picture_camera(frame.camera), ground_plane(frame.camera, frame.scene.vehicle), width,
-        height, 0xffff, scene_depth_cm_);
+    // Hidden by what the picture shows nearer; no cabin of ours. A picture's own depth is taken
+    // once a picture (its serial); the ground's moves with the car, every frame.
+    const sim::ClientImage* image =
+        frame.scene.client_images[static_cast<std::size_t>(frame.spec.view)].get();
+    const std::uint64_t serial = image && !image->depth_m.empty() ? image->serial : 0;
+    if (serial == 0 || serial != scene_depth_serial_ ||
+        scene_depth_cm_.size() != static_cast<std::size_t>(width) * height) {
+      picture_layer_depth_cm(image, picture_camera(frame.camera),
+                             ground_plane(frame.camera, frame.scene.vehicle), width, height, 0xffff,
+                             scene_depth_cm_);
+      scene_depth_serial_ = serial;
+    }
     in.scene_depth_cm = scene_depth_cm_;
   } else if (is_driver_view(frame.spec.view)) {
     in.cabin_tiles = cabin_tiles_for(frame, width, height);

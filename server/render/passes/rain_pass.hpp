@@ -70,6 +70,7 @@ class RainPass final : public Pass {
   std::vector<RainOccluder> occluders_;        // this frame's cars, for the layer
   std::vector<RainLamp> lamps_;                // and its lamps
   std::vector<std::uint16_t> scene_depth_cm_;  // and over a client's picture, its depth
+  std::uint64_t scene_depth_serial_ = 0;       // of the picture it is (0: the ground's)
   // The layer's tiles that the cabin hides, per driver's camera (cabin_tiles.hpp), the latest few.
   struct CabinTiles {
     int width = 0, height = 0;
