@@ -354,8 +354,6 @@ grpc::Status to_depth(const v1::ClientImage& in, const std::string& field, int w
   }
 }
 
-std::string view_proto_name(sim::View view) { return "VIEW_" + std::string(sim::view_name(view)); }
-
 }  // namespace
 
 grpc::Status to_client_images(const v1::Update& in, const std::string& field,
@@ -371,9 +369,8 @@ grpc::Status to_client_images(const v1::Update& in, const std::string& field,
                                    [&](const sim::ViewSpec& v) { return known && v.view == view; });
     if (spec == views.end())
       return invalid(f + ".view", "the session has no view " + std::to_string(c.view()));
-    const std::string name = view_proto_name(spec->view);
     if (spec->background != sim::Background::kClient) {
-      return invalid(f + ".view", name +
+      return invalid(f + ".view", v1::View_Name(c.view()) +
                                       " draws the server's world (BACKGROUND_RENDERED): create the "
                                       "session with its background BACKGROUND_CLIENT to send it "
                                       "pictures");
