@@ -4,15 +4,6 @@
 #include "server/render/cpu/glass_view.hpp"
 
 namespace downpour::render {
-namespace {
-
-bool picture_has_depth(const FrameContext& f) {
-  const auto& image = f.scene.client_images[static_cast<std::size_t>(f.spec.view)];
-  return image && !image->depth_m.empty();
-}
-
-}  // namespace
-
 void ClientBackgroundPass::execute(const FrameContext&, const FrameResources& r) {
   const TargetTexture& picture = r.client_colour;
   // (Before the first picture a 1 x 1 black one: the view's clear colour stays.)
@@ -37,7 +28,7 @@ ClientEnvironmentPass::ClientEnvironmentPass(SharedResources& shared)
       u_glass_depth_(program_.uniform("u_glass_depth")),
       u_near_(program_.uniform("u_near")) {}
 
-void ClientEnvironmentPass::execute(const FrameContext& frame, const FrameResources&) {
+void ClientEnvironmentPass::execute(const FrameContext& frame, const FrameResources& r) {
   // The picture's camera: the view's, not the face's that this draws from.
   const Camera& view_camera = frame.picture_camera ? *frame.picture_camera : frame.camera;
   const PictureCamera c = picture_camera(view_camera);
@@ -50,7 +41,7 @@ void ClientEnvironmentPass::execute(const FrameContext& frame, const FrameResour
   u_glass_depth_.set(GlassView(view_camera, frame.scene.glass, 1).depth_over_image());
   u_near_.set(view_camera.near_m);
   u_ground_.set(glm::vec4(g.normal, g.camera_height_m));
-  u_has_depth_.set(picture_has_depth(frame) ? 1 : 0);
+  u_has_depth_.set(r.client_depth.texture ? 1 : 0);
   shared_.fullscreen.draw();
 }
 
