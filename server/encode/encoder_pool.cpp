@@ -3,6 +3,7 @@
 #include <chrono>
 #include <exception>
 
+#include "server/encode/ground_truth.hpp"
 #include "server/encode/jpeg_encoder.hpp"
 
 namespace downpour::encode {
@@ -80,15 +81,20 @@ void EncoderPool::run() {
       queue_.pop_front();
     }
     const auto t0 = std::chrono::steady_clock::now();
-    std::string jpeg;
+    EncodedImages images;
     try {
-      jpeg = encoder.encode({job.rgba.data(), job.width, job.height}, job.quality);
+      images.jpeg = encoder.encode({job.rgba.data(), job.width, job.height}, job.quality);
+      if (job.clean_jpeg)
+        images.clean_jpeg = encoder.encode({job.clean.data(), job.width, job.height}, job.quality);
+      if (job.water_mask)
+        images.water_mask_png = water_mask_png(job.rgba, job.clean, job.width, job.height);
+      if (!job.depth_m.empty()) images.depth_png = depth_png(job.depth_m, job.width, job.height);
     } catch (const std::exception&) {
-      jpeg.clear();  // the job's owner reports the failure
+      images.jpeg.clear();  // the job's owner reports the failure
     }
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    job.done(std::move(jpeg), ms);
+    job.done(std::move(images), ms);
     {
       std::lock_guard lock(mutex_);
       --reserved_;

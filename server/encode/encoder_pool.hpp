@@ -14,13 +14,27 @@
 
 namespace downpour::encode {
 
+// A frame's files: its JPEG and the ground truth it asked for (empty where not).
+struct EncodedImages {
+  std::string jpeg;
+  std::string clean_jpeg;
+  std::string water_mask_png;
+  std::string depth_png;
+};
+
 struct EncodeJob {
   std::vector<std::uint8_t> rgba;  // bottom-up rows
   int width = 0;
   int height = 0;
   int quality = 85;
-  // Runs on the worker with the JPEG (empty on failure) and the encode time.
-  std::function<void(std::string jpeg, double encode_ms)> done;
+  // Ground truth: the clean frame (RGBA8, bottom-up rows, as rgba) and what to make of it, and the
+  // depth in metres (bottom-up rows); empty, none.
+  std::vector<std::uint8_t> clean;
+  bool clean_jpeg = false;
+  bool water_mask = false;
+  std::vector<float> depth_m;
+  // Runs on the worker with the files (jpeg empty on any failure) and the encode time.
+  std::function<void(EncodedImages images, double encode_ms)> done;
 };
 
 class EncoderPool {

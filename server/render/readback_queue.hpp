@@ -27,7 +27,8 @@ class ReadbackQueue {
     entries_.push_back({readback, std::move(payload), false});
   }
 
-  // Hands each finished readback to take(payload, pixels, wait_ms), pixels RGBA8 rows bottom-up:
+  // Hands each finished readback to take(payload, pixels, truth, wait_ms), pixels RGBA8 rows
+  // bottom-up and truth the ground truth its view asked for (GroundTruthPixels):
   // those that are ready, those left from an earlier call (waiting for them), or all of them. A
   // readback that fails (the GPU's fence past its deadline, a buffer that cannot be mapped or
   // allocated) goes to fail(payload, what) instead, and the others go on.
@@ -42,16 +43,17 @@ class ReadbackQueue {
       }
       const auto t0 = std::chrono::steady_clock::now();
       std::vector<std::uint8_t> pixels;
+      GroundTruthPixels truth;
       try {
         pixels = buffers_(static_cast<std::size_t>(e.readback.width) * e.readback.height * 4);
-        renderer_.finish(e.readback, pixels);
+        renderer_.finish(e.readback, pixels, &truth);
       } catch (const std::exception& error) {
         fail(std::move(e.payload), error.what());
         continue;
       }
       const double wait_ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      take(std::move(e.payload), std::move(pixels), wait_ms);
+      take(std::move(e.payload), std::move(pixels), std::move(truth), wait_ms);
     }
     entries_ = std::move(waiting);
   }

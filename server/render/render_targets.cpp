@@ -36,16 +36,35 @@ Framebuffer framebuffer_with(GLuint colour, GLuint depth) {
   return fbo;
 }
 
+namespace {
+
+// Readback buffers of `bytes` each.
+std::array<Buffer, kReadbackSlots> readback_buffers(std::size_t bytes) {
+  std::array<Buffer, kReadbackSlots> out;
+  GLuint ids[kReadbackSlots];
+  glCreateBuffers(kReadbackSlots, ids);
+  for (int i = 0; i < kReadbackSlots; ++i) {
+    out[i] = Buffer(ids[i]);
+    glNamedBufferStorage(ids[i], static_cast<GLsizeiptr>(bytes), nullptr, GL_MAP_READ_BIT);
+  }
+  return out;
+}
+
+}  // namespace
+
+GroundTruthTarget::GroundTruthTarget(int w, int h, GLuint view_depth) {
+  const std::size_t pixels = static_cast<std::size_t>(w) * h;
+  clean = make_texture_2d(GL_RGBA8, w, h);
+  clean_fbo = framebuffer_with(clean.id(), view_depth);
+  clean_pbo = readback_buffers(pixels * 4);
+  depth_pbo = readback_buffers(pixels * sizeof(float));
+}
+
 ViewTarget::ViewTarget(int w, int h) : width(w), height(h) {
   colour = make_texture_2d(GL_RGBA8, w, h);
   depth = make_texture_2d(GL_DEPTH_COMPONENT32F, w, h);
   fbo = framebuffer_with(colour.id(), depth.id());
-  GLuint ids[kReadbackSlots];
-  glCreateBuffers(kReadbackSlots, ids);
-  for (int i = 0; i < kReadbackSlots; ++i) {
-    pbo[i] = Buffer(ids[i]);
-    glNamedBufferStorage(ids[i], static_cast<GLsizeiptr>(w) * h * 4, nullptr, GL_MAP_READ_BIT);
-  }
+  pbo = readback_buffers(static_cast<std::size_t>(w) * h * 4);
 }
 
 ViewTarget::~ViewTarget() {

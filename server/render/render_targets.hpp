@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <tuple>
 
 #include "server/render/gl/gl_objects.hpp"
@@ -19,6 +20,19 @@ inline constexpr int kReadbackSlots = 2;
 // A framebuffer with these attachments (0: none); throws if GL finds it incomplete.
 Framebuffer framebuffer_with(GLuint colour, GLuint depth);
 
+// A view's ground truth (sim::Outputs) on its way back: the clean frame's colour (the view's
+// colour before the first pass that adds water; its framebuffer has the view's depth, so that the
+// blades drawn over it hide behind the cabin as they do in the frame), and readback buffers for it
+// and for the view's depth.
+struct GroundTruthTarget {
+  Texture clean;
+  Framebuffer clean_fbo;
+  std::array<Buffer, kReadbackSlots> clean_pbo;
+  std::array<Buffer, kReadbackSlots> depth_pbo;
+
+  GroundTruthTarget(int w, int h, GLuint view_depth);
+};
+
 // A view's colour and depth, and its readback buffers.
 struct ViewTarget {
   int width = 0;
@@ -29,6 +43,7 @@ struct ViewTarget {
   std::array<Buffer, kReadbackSlots> pbo;
   std::array<GLsync, kReadbackSlots> fence{};  // a readback in flight per slot
   int next_slot = 0;
+  std::unique_ptr<GroundTruthTarget> truth;  // made for the first frame that asks for outputs
 
   ViewTarget(int w, int h);
   ~ViewTarget();

@@ -21,6 +21,7 @@
 #include "server/render/frame_context.hpp"
 #include "server/render/frame_lamps.hpp"
 #include "server/render/pass.hpp"
+#include "server/render/passes/glass_composite_pass.hpp"
 #include "server/render/passes/lamp_map_pass.hpp"
 #include "server/render/passes/rain_pass.hpp"
 #include "server/render/passes/road_pass.hpp"
@@ -75,7 +76,6 @@ struct Renderer::Impl {
   std::vector<PassTiming> timings;
   std::uint64_t frame = 0;                       // frames rendered, for the transients' use
   std::unique_ptr<RenderSession> image_session;  // render_image's
-  float image_near_m = 0.05f;                    // its camera's near plane
   bool view_drew_relief = false;   // the view's road pass (not the environment's faces)
   std::uint32_t rain_streaks = 0;  // drawn by the last render()
 
@@ -422,6 +422,12 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
   if (target->fence[slot]) throw std::logic_error("readback slot reused before finish()");
 
   const Camera camera = make_camera(spec, scene.vehicle, &scene.weather);
+  // Ground truth: the clean frame (for itself or the water mask) and the depth.
+  const bool wants_clean = spec.outputs.clean || spec.outputs.water_mask;
+  if (spec.outputs.any() && !target->truth) {
+    target->truth =
+        std::make_unique<GroundTruthTarget>(spec.width, spec.height, target->depth.id());
+  }
   FrameContext frame{
       scene,
       spec,
@@ -465,7 +471,19 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
     m.timed(pass->decl().name, [&] { m.run_pass(*pass, frame, s, resources); });
   const bool fixed = m.fixed_environment && spec.view == sim::View::kCockpit && !client;
   m.passes.rain->take_drawn();
+  bool clean_taken = false;
+  auto take_clean = [&] {
+    m.timed("clean_copy", [&] {
+      glCopyImageSubData(target->colour.id(), GL_TEXTURE_2D, 0, 0, 0, 0, target->truth->clean.id(),
+                         GL_TEXTURE_2D, 0, 0, 0, 0, spec.width, spec.height, 1);
+    });
+    clean_taken = true;
+  };
   for (Pass* pass : fixed ? m.passes.fixed_environment_cockpit : m.view_list(spec)) {
+    // The clean frame is the view before the first pass that adds water.
+    if (wants_clean && !clean_taken &&
+        std::find(m.passes.water.begin(), m.passes.water.end(), pass) != m.passes.water.end())
+      take_clean();
     // The world outside the glass, for the first pass that reads it and has something to draw
     // (it waits for the step, as that pass would).
     const auto& reads = pass->decl().reads;
@@ -479,7 +497,18 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
     }
     m.timed(pass->decl().name, [&] { m.run_pass(*pass, frame, s, resources); });
     if (pass == m.passes.road) m.view_drew_relief = m.passes.road->drew_relief();
+    // The glass without its water keeps its blades.
+    if (wants_clean && pass == static_cast<Pass*>(m.passes.glass_composite) &&
+        pass->wanted(frame)) {
+      m.timed("clean_blades", [&] {
+        glBindFramebuffer(GL_FRAMEBUFFER, target->truth->clean_fbo.id());
+        apply(pass->decl().state);
+        m.passes.glass_composite->draw_blades(frame);
+        glBindFramebuffer(GL_FRAMEBUFFER, target->fbo.id());
+      });
+    }
   }
+  if (wants_clean && !clean_taken) take_clean();  // a view that adds no water
   const RainPass::Drawn rain = m.passes.rain->take_drawn();
   m.rain_streaks = rain.streaks;
   // The rain pass's CPU layer, beside the whole pass, for the budget table.
@@ -495,12 +524,24 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
     throw std::runtime_error(text);
   }
 
-  PendingReadback pending{&session, view_index, slot, nullptr, spec.width, spec.height};
+  PendingReadback pending{&session,   view_index,  slot,         nullptr,
+                          spec.width, spec.height, spec.outputs, camera.near_m};
   m.timed("readback_start", [&] {
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glNamedFramebufferReadBuffer(target->fbo.id(), GL_COLOR_ATTACHMENT0);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, target->fbo.id());
     glBindBuffer(GL_PIXEL_PACK_BUFFER, target->pbo[slot].id());
     glReadPixels(0, 0, spec.width, spec.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    if (spec.outputs.depth) {
+      glBindBuffer(GL_PIXEL_PACK_BUFFER, target->truth->depth_pbo[slot].id());
+      glReadPixels(0, 0, spec.width, spec.height, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+    }
+    if (wants_clean) {
+      glNamedFramebufferReadBuffer(target->truth->clean_fbo.id(), GL_COLOR_ATTACHMENT0);
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, target->truth->clean_fbo.id());
+      glBindBuffer(GL_PIXEL_PACK_BUFFER, target->truth->clean_pbo[slot].id());
+      glReadPixels(0, 0, spec.width, spec.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    }
     glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     glFlush();
@@ -517,7 +558,21 @@ bool Renderer::is_ready(const PendingReadback& pending) const {
   return status == GL_SIGNALED;
 }
 
-void Renderer::finish(const PendingReadback& pending, std::vector<std::uint8_t>& out) {
+namespace {
+
+// A readback buffer's first `bytes`, mapped, handed to `use`.
+template <typename Use>
+void read_buffer(GLuint pbo, std::size_t bytes, Use&& use) {
+  const void* data = glMapNamedBufferRange(pbo, 0, static_cast<GLsizeiptr>(bytes), GL_MAP_READ_BIT);
+  if (!data) throw std::runtime_error("mapping the readback buffer failed");
+  use(data);
+  glUnmapNamedBuffer(pbo);
+}
+
+}  // namespace
+
+void Renderer::finish(const PendingReadback& pending, std::vector<std::uint8_t>& out,
+                      GroundTruthPixels* truth) {
   if (!pending.session) throw std::logic_error("finish() of an empty readback");
   RenderSession::Impl& s = *pending.session->impl_;
   if (static_cast<std::size_t>(pending.view_index) >= s.views.size() ||
@@ -542,45 +597,58 @@ void Renderer::finish(const PendingReadback& pending, std::vector<std::uint8_t>&
                                  : "the GPU did not finish a frame within " +
                                        std::to_string(kFenceDeadline.count()) + " s");
   }
-  const std::size_t bytes = static_cast<std::size_t>(pending.width) * pending.height * 4;
-  out.resize(bytes);
-  const GLuint pbo = target.pbo[pending.slot].id();
-  const void* data = glMapNamedBufferRange(pbo, 0, static_cast<GLsizeiptr>(bytes), GL_MAP_READ_BIT);
-  if (!data) throw std::runtime_error("mapping the readback buffer failed");
-  std::memcpy(out.data(), data, bytes);
-  glUnmapNamedBuffer(pbo);
+  const std::size_t pixels = static_cast<std::size_t>(pending.width) * pending.height;
+  out.resize(pixels * 4);
+  read_buffer(target.pbo[pending.slot].id(), out.size(),
+              [&](const void* data) { std::memcpy(out.data(), data, out.size()); });
+  if (!truth) return;
+  truth->clean.clear();
+  truth->depth_m.clear();
+  if (pending.outputs.clean || pending.outputs.water_mask) {
+    truth->clean.resize(pixels * 4);
+    read_buffer(target.truth->clean_pbo[pending.slot].id(), truth->clean.size(),
+                [&](const void* data) { std::memcpy(truth->clean.data(), data, pixels * 4); });
+  }
+  if (pending.outputs.depth) {
+    truth->depth_m.resize(pixels);
+    read_buffer(target.truth->depth_pbo[pending.slot].id(), pixels * sizeof(float),
+                [&](const void* data) {
+                  const auto* z = static_cast<const float*>(data);
+                  for (std::size_t i = 0; i < pixels; ++i)
+                    truth->depth_m[i] = distance_from_reversed_z(pending.near_m, z[i]);
+                });
+  }
 }
 
 std::vector<std::uint8_t> Renderer::render_image(const sim::ViewSpec& spec,
                                                  const sim::SceneState& scene) {
+  GroundTruthPixels unused;
+  sim::ViewSpec plain = spec;
+  plain.outputs = {};
+  return render_image(plain, scene, unused);
+}
+
+std::vector<std::uint8_t> Renderer::render_image(const sim::ViewSpec& spec,
+                                                 const sim::SceneState& scene,
+                                                 GroundTruthPixels& truth) {
   if (!impl_->image_session) impl_->image_session = open_session();
   // A picture of this scene alone: the world outside the glass drawn for it, not a session's
   // earlier ticks.
   if (!impl_->fixed_environment) impl_->image_session->impl_->environment.reset();
-  impl_->image_near_m = make_camera(spec, scene.vehicle, &scene.weather).near_m;
   const PendingReadback pending = render(*impl_->image_session, 0, spec, scene);
   std::vector<std::uint8_t> bottom_up;
-  finish(pending, bottom_up);
-  std::vector<std::uint8_t> top_down(bottom_up.size());
+  finish(pending, bottom_up, &truth);
+  auto flip = [&spec](auto& image, std::size_t row) {
+    for (int y = 0; y < spec.height / 2; ++y) {
+      std::swap_ranges(image.begin() + y * row, image.begin() + (y + 1) * row,
+                       image.begin() + (spec.height - 1 - y) * row);
+    }
+  };
   const std::size_t row = static_cast<std::size_t>(spec.width) * 4;
-  for (int y = 0; y < spec.height; ++y) {
-    std::memcpy(&top_down[y * row], &bottom_up[(spec.height - 1 - y) * row], row);
-  }
-  return top_down;
-}
-
-std::vector<float> Renderer::last_image_depth_m() {
-  if (!impl_->image_session || impl_->image_session->impl_->views.empty() ||
-      !impl_->image_session->impl_->views[0])
-    throw std::logic_error("last_image_depth_m() before render_image()");
-  const ViewTarget& target = *impl_->image_session->impl_->views[0];
-  const int w = target.width, h = target.height;
-  std::vector<float> out(static_cast<std::size_t>(w) * h);
-  glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  glGetTextureImage(target.depth.id(), 0, GL_DEPTH_COMPONENT, GL_FLOAT,
-                    static_cast<GLsizei>(out.size() * sizeof(float)), out.data());
-  for (float& d : out) d = distance_from_reversed_z(impl_->image_near_m, d);
-  return out;
+  flip(bottom_up, row);
+  if (!truth.clean.empty()) flip(truth.clean, row);
+  if (!truth.depth_m.empty()) flip(truth.depth_m, static_cast<std::size_t>(spec.width));
+  return bottom_up;
 }
 
 bool box_visible(const glm::mat4& m, const glm::vec3& lo, const glm::vec3& hi) {

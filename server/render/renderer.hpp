@@ -55,6 +55,15 @@ struct PendingReadback {
   void* fence = nullptr;
   int width = 0;
   int height = 0;
+  sim::Outputs outputs;  // the ground truth read back with it
+  float near_m = 0.0f;   // its camera's near plane (its depth's scale)
+};
+
+// A view's ground truth read back with its pixels (sim::Outputs), rows bottom-up; each empty where
+// the view did not ask for it.
+struct GroundTruthPixels {
+  std::vector<std::uint8_t> clean;  // RGBA8: the frame without its water (clean or water mask)
+  std::vector<float> depth_m;       // along the view's axis; 0 where nothing was drawn (the sky)
 };
 
 // The simulation's state after the frame's step (the water on the glass, the rain): called once a
@@ -111,16 +120,19 @@ class Renderer {
   PendingReadback render(RenderSession& session, int view_index, const sim::ViewSpec& spec,
                          const sim::SceneState& scene);
   bool is_ready(const PendingReadback& pending) const;
-  // Waits if needed; out gets RGBA8 rows bottom-up.
-  void finish(const PendingReadback& pending, std::vector<std::uint8_t>& out);
+  // Waits if needed; out gets RGBA8 rows bottom-up, and truth (where given) the ground truth the
+  // view asked for.
+  void finish(const PendingReadback& pending, std::vector<std::uint8_t>& out,
+              GroundTruthPixels* truth = nullptr);
 
   // Renders one view of the scene by itself and waits for its pixels, rows top-down (tests,
   // tools).
   std::vector<std::uint8_t> render_image(const sim::ViewSpec& spec, const sim::SceneState& scene);
-  // The depth of the last render_image's view along its axis (m; 0 where nothing was drawn: the
-  // sky), rows bottom-up: a client's picture's depth as the server holds it
-  // (sim::ClientImage::depth_m).
-  std::vector<float> last_image_depth_m();
+  // The same with the ground truth the spec asks for (ViewSpec::outputs), rows top-down as well:
+  // a client's picture's depth as the server holds it (sim::ClientImage::depth_m) is the flipped
+  // depth_m (rows bottom-up).
+  std::vector<std::uint8_t> render_image(const sim::ViewSpec& spec, const sim::SceneState& scene,
+                                         GroundTruthPixels& truth);
 
   // Frees the shared intermediate targets (remade on demand): after sessions close, so that the
   // memory of their sizes goes back. Between frames only.

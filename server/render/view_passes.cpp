@@ -45,7 +45,8 @@ ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
   Pass* environment_background = own(std::make_unique<EnvironmentBackgroundPass>(shared));
   GlassWaterPass* glass_water = own(std::make_unique<GlassWaterPass>(shared));
   Pass* glass_water_mask = own(std::make_unique<GlassWaterMaskPass>(shared, *glass_water));
-  Pass* glass_composite = own(std::make_unique<GlassCompositePass>(shared));
+  p.glass_composite = own(std::make_unique<GlassCompositePass>(shared));
+  Pass* glass_composite = p.glass_composite;
   Pass* windshield = own(std::make_unique<WindshieldPass>(shared));
   // The spray's chain: maps, smoothing, shading, haze, haze over, composite (spray_pass.hpp).
   p.spray = own(std::make_unique<SprayPass>(shared));
@@ -57,6 +58,7 @@ ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
                                     own(std::make_unique<SprayHazePass>(shared, *p.spray)),
                                     own(std::make_unique<SprayHazeOverPass>(shared, *p.spray)),
                                     own(std::make_unique<SprayCompositePass>(shared, *p.spray))};
+  p.water = {rain, spray.front(), glass_water_mask, glass_water, glass_composite};
   p.lamp_map = own(std::make_unique<LampMapPass>(lamps));
   // What the road's mirror shows, each clipped this far above the road's plane.
   p.reflection = own(std::make_unique<RoadReflectionPass>(

@@ -15,6 +15,7 @@
 
 namespace downpour::render {
 
+class GlassCompositePass;
 class LampMapPass;
 class RainPass;
 class RoadPass;
@@ -36,7 +37,11 @@ struct ViewPasses {
   // what the server adds over it; and what draws the probe's faces from the picture.
   std::array<std::vector<Pass*>, sim::kViewCount> client_views;
   std::vector<Pass*> client_environment;
+  // The passes that add water (the rain, the spray, the glass's water): a view's clean frame
+  // (ground truth, sim::Outputs) is its colour before the first of them.
+  std::vector<const Pass*> water;
   // Those the renderer asks or tells something of.
+  GlassCompositePass* glass_composite = nullptr;
   LampMapPass* lamp_map = nullptr;
   RoadReflectionPass* reflection = nullptr;
   RoadPass* road = nullptr;

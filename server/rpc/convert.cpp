@@ -39,6 +39,9 @@ void fill_frame(const session::EncodedFrame& f, std::uint64_t reader_drops, v1::
   out->set_width(static_cast<std::uint32_t>(f.width));
   out->set_height(static_cast<std::uint32_t>(f.height));
   out->set_jpeg(f.jpeg);
+  if (!f.clean_jpeg.empty()) out->set_clean_jpeg(f.clean_jpeg);
+  if (!f.water_mask_png.empty()) out->set_water_mask_png(f.water_mask_png);
+  if (!f.depth_png.empty()) out->set_depth_png(f.depth_png);
   v1::FrameStats* s = out->mutable_stats();
   s->set_render_ms(f.stats.render_ms);
   s->set_readback_ms(f.stats.readback_ms);
@@ -100,6 +103,9 @@ void fill_session_info(const session::Session& session, v1::SessionInfo* out) {
     if (v.exposure_s) spec->set_exposure_s(*v.exposure_s);
     spec->set_background(v.background == sim::Background::kClient ? v1::BACKGROUND_CLIENT
                                                                   : v1::BACKGROUND_RENDERED);
+    if (v.outputs.clean) spec->add_outputs(v1::OUTPUT_CLEAN);
+    if (v.outputs.water_mask) spec->add_outputs(v1::OUTPUT_WATER_MASK);
+    if (v.outputs.depth) spec->add_outputs(v1::OUTPUT_DEPTH);
   }
   out->set_frames_rendered(session.frames_rendered());
   out->set_sim_time_s(session.sim_time_s());

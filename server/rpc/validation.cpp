@@ -314,6 +314,36 @@ grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, cons
                      "must be BACKGROUND_RENDERED or BACKGROUND_CLIENT, got " +
                          std::to_string(in.background()));
   }
+  for (int i = 0; i < in.outputs_size(); ++i) {
+    const std::string f = field + ".outputs[" + std::to_string(i) + "]";
+    bool* wanted = nullptr;
+    switch (in.outputs(i)) {
+      case v1::OUTPUT_CLEAN:
+        wanted = &out->outputs.clean;
+        break;
+      case v1::OUTPUT_WATER_MASK:
+        wanted = &out->outputs.water_mask;
+        break;
+      case v1::OUTPUT_DEPTH:
+        if (out->background == sim::Background::kClient)
+          return invalid(f,
+                         "OUTPUT_DEPTH is for views of the server's world: a client's "
+                         "picture's depth is the client's own");
+        wanted = &out->outputs.depth;
+        break;
+      default:
+        return invalid(f, "must be OUTPUT_CLEAN, OUTPUT_WATER_MASK or OUTPUT_DEPTH, got " +
+                              std::to_string(in.outputs(i)));
+    }
+    if (*wanted) return invalid(f, v1::Output_Name(in.outputs(i)) + " is asked for twice");
+    *wanted = true;
+  }
+  if (out->outputs.any() && out->view == sim::View::kWindshield &&
+      out->background == sim::Background::kRendered) {
+    return invalid(field + ".outputs",
+                   "VIEW_WINDSHIELD over the server's world is itself the water's ground truth: "
+                   "no outputs");
+  }
   return grpc::Status::OK;
 }
 

@@ -36,6 +36,10 @@ struct EncodedFrame {
   int width = 0;
   int height = 0;
   std::string jpeg;
+  // The ground truth the view asked for (sim::Outputs), from the same tick; empty otherwise.
+  std::string clean_jpeg;
+  std::string water_mask_png;  // 8-bit grey
+  std::string depth_png;       // 16-bit grey, centimetres
   FrameStats stats;
   std::array<sim::TireWater, sim::kTires> tires{};  // the tick's: the road's water under the tires
   sim::EgoPlace ego_place;                          // the tick's

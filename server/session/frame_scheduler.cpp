@@ -457,8 +457,9 @@ void FrameScheduler::tick(const std::shared_ptr<Session>& s, const StartedStep& 
 void FrameScheduler::collect(bool all) {
   readbacks_->collect(
       all,
-      [this](InFlight f, std::vector<std::uint8_t> pixels, double wait_ms) {
-        encode(std::move(f), std::move(pixels), wait_ms);
+      [this](InFlight f, std::vector<std::uint8_t> pixels, render::GroundTruthPixels truth,
+             double wait_ms) {
+        encode(std::move(f), std::move(pixels), std::move(truth), wait_ms);
       },
       [this](InFlight f, const std::string& what) {
         // The frame is lost: its step fails and its session ends; the other sessions go on.
@@ -471,15 +472,21 @@ void FrameScheduler::collect(bool all) {
       });
 }
 
-void FrameScheduler::encode(InFlight f, std::vector<std::uint8_t> pixels, double readback_ms) {
+void FrameScheduler::encode(InFlight f, std::vector<std::uint8_t> pixels,
+                            render::GroundTruthPixels truth, double readback_ms) {
   const sim::ViewSpec& spec = f.session->config().views[f.view_index];
   encode::EncodeJob job;
   job.rgba = std::move(pixels);
   job.width = spec.width;
   job.height = spec.height;
   job.quality = spec.jpeg_quality;
-  job.done = [this, f = std::move(f), readback_ms, spec](std::string jpeg, double encode_ms) {
-    if (jpeg.empty()) {
+  job.clean = std::move(truth.clean);
+  job.clean_jpeg = spec.outputs.clean;
+  job.water_mask = spec.outputs.water_mask;
+  job.depth_m = std::move(truth.depth_m);
+  job.done = [this, f = std::move(f), readback_ms, spec](encode::EncodedImages images,
+                                                         double encode_ms) {
+    if (images.jpeg.empty()) {
       spdlog::error("session {}: encoding frame {} failed", f.session->id(), f.frame_number);
       f.collector->add(f.view_index, nullptr);
       return;
@@ -492,7 +499,10 @@ void FrameScheduler::encode(InFlight f, std::vector<std::uint8_t> pixels, double
     frame->view = spec.view;
     frame->width = spec.width;
     frame->height = spec.height;
-    frame->jpeg = std::move(jpeg);
+    frame->jpeg = std::move(images.jpeg);
+    frame->clean_jpeg = std::move(images.clean_jpeg);
+    frame->water_mask_png = std::move(images.water_mask_png);
+    frame->depth_png = std::move(images.depth_png);
     frame->stats.render_ms = f.render_ms;
     frame->stats.readback_ms = readback_ms;
     frame->stats.encode_ms = encode_ms;

@@ -100,7 +100,8 @@ class FrameScheduler {
   void drop_step_ahead(EndReason reason, const std::string& why);
   void collect(bool all);
   void loop_once(Clock::time_point now);  // one turn of the render loop
-  void encode(InFlight f, std::vector<std::uint8_t> pixels, double readback_ms);
+  void encode(InFlight f, std::vector<std::uint8_t> pixels, render::GroundTruthPixels truth,
+              double readback_ms);
   void record(std::vector<double>& window, std::size_t& next, double value);
 
   SessionRegistry& registry_;

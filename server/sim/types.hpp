@@ -139,6 +139,15 @@ struct EgoGeometry {
 
 enum class Background { kRendered, kClient };
 
+// The ground truth a view's frames carry beside the picture (the contract's Output).
+struct Outputs {
+  bool clean = false;       // the frame without the water (glass water and film, rain, spray)
+  bool water_mask = false;  // how much the water changes each pixel (needs the clean frame)
+  bool depth = false;       // distance along the view's axis
+  bool any() const { return clean || water_mask || depth; }
+  bool operator==(const Outputs&) const = default;
+};
+
 struct ViewSpec {
   View view = View::kCockpit;
   int width = 640;
@@ -158,6 +167,7 @@ struct ViewSpec {
   std::optional<double> exposure_s;
   // What lies behind the rain: the server's world, or the client's pictures (ClientImage).
   Background background = Background::kRendered;
+  Outputs outputs;
   // The driver's eye in the vehicle frame (the session's EgoGeometry): where the COCKPIT and RAIN
   // views look from without a camera of their own.
   glm::dvec3 eye_m = EgoGeometry{}.eye_m;

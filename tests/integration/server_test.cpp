@@ -17,6 +17,7 @@
 
 #include "downpour/v1/downpour.grpc.pb.h"
 #include "grpc_health/v1/health.grpc.pb.h"
+#include "server/encode/image_decoder.hpp"
 #include "tests/integration/requests.hpp"
 #include "tests/integration/server_process.hpp"
 #include "tests/support/png_io.hpp"
@@ -254,6 +255,97 @@ TEST_F(ServerTest, ClientPicturesComeThroughAndBadOnesAreRefused) {
   ASSERT_TRUE(step_with(0.20, {}, &after).ok());
   EXPECT_GT(decode(after.frames(0).jpeg()).mean(0), 150.0);
   close(id);
+}
+
+// Ground truth with the frame: a clean JPEG, a water mask and a depth from the same tick, for the
+// views that ask; the mask is 0 where the frame and its clean frame agree (whole JPEG blocks come
+// back identical there) and above 0 where the water shows; a bad request for them is refused.
+TEST_F(ServerTest, GroundTruthComesWithTheFramesThatAskForIt) {
+  constexpr int kW = 160, kH = 96;  // whole 16 x 16 JPEG blocks
+  v1::ViewSpec cockpit = view(v1::VIEW_COCKPIT, kW, kH);
+  for (const v1::Output o : {v1::OUTPUT_CLEAN, v1::OUTPUT_WATER_MASK, v1::OUTPUT_DEPTH})
+    cockpit.add_outputs(o);
+  const std::string id = create(v1::MODE_LOCKSTEP, {cockpit, view(v1::VIEW_ROAD, 128, 72)});
+  v1::StepResponse resp;
+  for (int i = 1; i <= 10; ++i) ASSERT_TRUE(step(id, i * 0.1, 0.1, &resp).ok());
+  const v1::Frame& frame = resp.frames(0);
+  EXPECT_TRUE(resp.frames(1).clean_jpeg().empty()) << "ROAD asked for none";
+  EXPECT_TRUE(resp.frames(1).depth_png().empty());
+
+  // Decoded block by block (no smoothing of the colour across blocks).
+  auto decode_blocks = [](const std::string& jpeg) {
+    tjhandle h = tjInitDecompress();
+    std::vector<unsigned char> rgb(static_cast<std::size_t>(kW) * kH * 3);
+    const int r = tjDecompress2(h, reinterpret_cast<const unsigned char*>(jpeg.data()), jpeg.size(),
+                                rgb.data(), kW, 0, kH, TJPF_RGB, TJFLAG_FASTUPSAMPLE);
+    tjDestroy(h);
+    EXPECT_EQ(r, 0);
+    return rgb;
+  };
+  const std::vector<unsigned char> rainy = decode_blocks(frame.jpeg());
+  const std::vector<unsigned char> clean = decode_blocks(frame.clean_jpeg());
+  // (decoded rows bottom-up: row y of the picture is row kH - 1 - y here)
+  const encode::BgrxPixels mask = encode::decode_bgrx(frame.water_mask_png(), kW, kH);
+  const encode::Grey16Pixels depth = encode::decode_png_grey16(frame.depth_png(), kW, kH);
+  auto mask_at = [&](int x, int y) {
+    return mask.bgrx[(static_cast<std::size_t>(kH - 1 - y) * kW + x) * 4];
+  };
+  // The mask is 0 where the frames differ by 2 levels or less: JPEG blocks without water come back
+  // the same, or nearly (a change of 2 may move a quantized coefficient).
+  int dry_blocks = 0, wet_blocks = 0, wet_blocks_differ = 0, dry_worst = 0;
+  for (int by = 0; by < kH; by += 16) {
+    for (int bx = 0; bx < kW; bx += 16) {
+      int masked = 0, worst = 0;
+      for (int y = by; y < by + 16; ++y) {
+        for (int x = bx; x < bx + 16; ++x) {
+          masked += mask_at(x, y) > 0;
+          const std::size_t at = (static_cast<std::size_t>(y) * kW + x) * 3;
+          for (int c = 0; c < 3; ++c)
+            worst = std::max(worst, std::abs(rainy[at + c] - clean[at + c]));
+        }
+      }
+      if (masked == 0) dry_blocks += 1, dry_worst = std::max(dry_worst, worst);
+      if (masked > 64) wet_blocks += 1, wet_blocks_differ += worst >= 8;
+    }
+  }
+  std::size_t sky = 0, near = 0;
+  for (const std::uint16_t cm : depth.values) sky += cm == 0, near += cm > 0 && cm < 100;
+  std::printf(
+      "blocks without water: %d, the JPEGs at most %d levels apart there; with water: %d, "
+      "%d of them 8 levels apart or more; depth: %zu sky, %zu cabin pixels\n",
+      dry_blocks, dry_worst, wet_blocks, wet_blocks_differ, sky, near);
+  EXPECT_GT(dry_blocks, 5);
+  EXPECT_LT(dry_worst, 8);  // under what counts as water
+  EXPECT_GT(wet_blocks, 5);
+  EXPECT_EQ(wet_blocks_differ, wet_blocks);
+  EXPECT_GT(sky, 0u);   // the sky through the glass
+  EXPECT_GT(near, 0u);  // the cabin
+  close(id);
+
+  auto refused = [&](v1::ViewSpec spec, const std::string& says) {
+    v1::CreateSessionRequest req;
+    *req.add_views() = spec;
+    req.set_mode(v1::MODE_LOCKSTEP);
+    v1::SessionInfo info;
+    grpc::ClientContext ctx;
+    const grpc::Status s = stub->CreateSession(&ctx, req, &info);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << s.error_message();
+    EXPECT_NE(s.error_message().find(says), std::string::npos) << s.error_message();
+  };
+  v1::ViewSpec twice = view(v1::VIEW_COCKPIT, kW, kH);
+  twice.add_outputs(v1::OUTPUT_CLEAN);
+  twice.add_outputs(v1::OUTPUT_CLEAN);
+  refused(twice, "views[0].outputs[1]: OUTPUT_CLEAN is asked for twice");
+  v1::ViewSpec unspecified = view(v1::VIEW_COCKPIT, kW, kH);
+  unspecified.add_outputs(v1::OUTPUT_UNSPECIFIED);
+  refused(unspecified, "must be OUTPUT_CLEAN, OUTPUT_WATER_MASK or OUTPUT_DEPTH");
+  v1::ViewSpec windshield = view(v1::VIEW_WINDSHIELD, kW, kH);
+  windshield.add_outputs(v1::OUTPUT_WATER_MASK);
+  refused(windshield, "itself the water's ground truth");
+  v1::ViewSpec picture_depth = view(v1::VIEW_COCKPIT, kW, kH);
+  picture_depth.set_background(v1::BACKGROUND_CLIENT);
+  picture_depth.add_outputs(v1::OUTPUT_DEPTH);
+  refused(picture_depth, "the client's own");
 }
 
 // The same seed and inputs give the same frames: the driver's view and the rain in the air.

@@ -146,11 +146,19 @@ TEST_F(ClientBackgroundTest, WithoutDepthTheGroundHidesTheRainBeyondIt) {
 TEST_F(ClientBackgroundTest, DropsTurnThePictureOverAsTheyTurnTheWorldOver) {
   constexpr int kW = 1280, kH = 720;
   const sim::SceneState wet = testing::parked_in_rain(10.0, 3.0, 40.0, 0.3);
-  const sim::ViewSpec rendered = view_spec(sim::View::kCockpit, kW, kH);
-  const RgbaImage dry = render(rendered, without_water(wet));
+  // The rendered frame's ground truth (sim::Outputs): its clean frame (no water on the glass, no
+  // rain) and its depth are the picture.
+  sim::ViewSpec rendered = view_spec(sim::View::kCockpit, kW, kH);
+  rendered.outputs.clean = rendered.outputs.depth = true;
+  GroundTruthPixels truth;
+  const RgbaImage world{kW, kH, renderer().render_image(rendered, wet, truth)};
+  const RgbaImage dry{kW, kH, truth.clean};
   auto dry_picture = as_picture(dry);
-  dry_picture->depth_m = renderer().last_image_depth_m();
-  const RgbaImage world = render(rendered, wet);
+  dry_picture->depth_m.resize(truth.depth_m.size());
+  for (int y = 0; y < kH; ++y) {  // rows bottom-up, as the server holds a picture's depth
+    std::copy_n(&truth.depth_m[static_cast<std::size_t>(kH - 1 - y) * kW], kW,
+                &dry_picture->depth_m[static_cast<std::size_t>(y) * kW]);
+  }
   sim::SceneState over = wet;
   over.client_images[static_cast<int>(sim::View::kCockpit)] = dry_picture;
   const sim::ViewSpec spec = picture_view(sim::View::kCockpit, kW, kH);

@@ -8,6 +8,8 @@
 
 #include <png.h>
 
+#include "server/encode/png_encoder.hpp"
+
 namespace downpour::testing {
 
 void write_png(const std::string& path, const RgbaImage& image) {
@@ -31,45 +33,14 @@ void write_png(const std::string& path, const RgbaImage& image) {
   png_destroy_write_struct(&png, &info);
 }
 
-namespace {
-
-std::string png_bytes(int width, int height, int colour_type, int depth, const std::uint8_t* rows,
-                      std::size_t row_bytes) {
-  std::string out;
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png_create_info_struct(png);
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    throw std::runtime_error("libpng failed writing to memory");
-  }
-  png_set_write_fn(
-      png, &out,
-      [](png_structp p, png_bytep data, png_size_t n) {
-        static_cast<std::string*>(png_get_io_ptr(p))->append(reinterpret_cast<char*>(data), n);
-      },
-      nullptr);
-  png_set_IHDR(png, info, width, height, depth, colour_type, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  if (depth == 16) png_set_swap(png);  // this machine's order to PNG's big-endian
-  for (int y = 0; y < height; ++y)
-    png_write_row(png, const_cast<png_bytep>(rows + static_cast<std::size_t>(y) * row_bytes));
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  return out;
-}
-
-}  // namespace
-
 std::string png_bytes_rgb(int width, int height, const std::vector<std::uint8_t>& rgb) {
-  return png_bytes(width, height, PNG_COLOR_TYPE_RGB, 8, rgb.data(),
-                   static_cast<std::size_t>(width) * 3);
+  return encode::encode_png(rgb.data(), width, height, encode::PngFormat::kRgb8,
+                            encode::RowOrder::kTopDown);
 }
 
 std::string png_bytes_grey16(int width, int height, const std::vector<std::uint16_t>& values) {
-  return png_bytes(width, height, PNG_COLOR_TYPE_GRAY, 16,
-                   reinterpret_cast<const std::uint8_t*>(values.data()),
-                   static_cast<std::size_t>(width) * 2);
+  return encode::encode_png(values.data(), width, height, encode::PngFormat::kGrey16,
+                            encode::RowOrder::kTopDown);
 }
 
 RgbaImage read_png(const std::string& path) {

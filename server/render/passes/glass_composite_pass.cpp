@@ -22,7 +22,10 @@ void GlassCompositePass::execute(const FrameContext& frame, const FrameResources
   program_.use();
   u_inv_viewport_.set(1.0f / glm::vec2(resources.view_colour.width, resources.view_colour.height));
   quad_.draw(frame);
+  draw_blades(frame);
+}
 
+void GlassCompositePass::draw_blades(const FrameContext& frame) {
   // The blades on top, over their own footprints only.
   const float blur_mm = static_cast<float>(frame.glass.blur_mm());
   blade_program_.use();

@@ -15,6 +15,9 @@ class GlassCompositePass final : public Pass {
   const PassDecl& decl() const override { return decl_; }
   bool wanted(const FrameContext& frame) const override;
   void execute(const FrameContext& frame, const FrameResources& resources) override;
+  // The blades alone, under the pass's state into the bound target: the clean frame's (ground
+  // truth: the glass without its water keeps its blades).
+  void draw_blades(const FrameContext& frame);
 
  private:
   const PassDecl decl_{"glass_composite",

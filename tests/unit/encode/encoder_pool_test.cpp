@@ -148,7 +148,8 @@ TEST(EncoderPoolTest, EveryJobCompletesOnceAndFreesItsPlace) {
       job.width = kWidth;
       job.height = kHeight;
       job.quality = 80;
-      job.done = [&, i](std::string jpeg, double encode_ms) {
+      job.done = [&, i](EncodedImages images, double encode_ms) {
+        const std::string& jpeg = images.jpeg;
         {
           std::lock_guard lock(mutex);
           ++seen[i];
@@ -180,7 +181,7 @@ TEST(EncoderPoolTest, DestructorFinishesQueuedJobs) {
       job.rgba = rgba;
       job.width = kWidth;
       job.height = kHeight;
-      job.done = [&, i](std::string, double) {
+      job.done = [&, i](EncodedImages, double) {
         // The first job holds the worker until every job is queued.
         while (i == 0 && !release.load()) std::this_thread::yield();
         ++done;
@@ -204,7 +205,7 @@ TEST(EncoderPoolTest, FinishedJobsGiveTheirRoomBack) {
       job.rgba = rgba;
       job.width = kWidth;
       job.height = kHeight;
-      job.done = [&](std::string, double) { ++done; };
+      job.done = [&](EncodedImages, double) { ++done; };
       pool.submit(std::move(job));
     }
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
@@ -231,7 +232,7 @@ TEST(EncoderPoolTest, BuffersAreRecycled) {
     std::copy(rgba.begin(), rgba.end(), job.rgba.begin());
     job.width = kWidth;
     job.height = kHeight;
-    job.done = [&](std::string, double) { ++done; };
+    job.done = [&](EncodedImages, double) { ++done; };
     pool.submit(std::move(job));
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     while (!pool.try_reserve(1)) {

@@ -600,6 +600,23 @@ TEST(ValidationTest, TheBackgroundIsTakenAndEchoed) {
   EXPECT_TRUE(invalid_naming(to_session_config(rain, Limits{}, &config, &initial), "background"));
 }
 
+TEST(ValidationTest, OutputsAreTakenOnceEach) {
+  v1::CreateSessionRequest r = good_request();
+  r.mutable_views(0)->add_outputs(v1::OUTPUT_WATER_MASK);
+  r.mutable_views(0)->add_outputs(v1::OUTPUT_DEPTH);
+  session::SessionConfig config;
+  sim::Update initial;
+  ASSERT_TRUE(to_session_config(r, Limits{}, &config, &initial).ok());
+  EXPECT_EQ(config.views[0].outputs, (sim::Outputs{false, true, true}));
+  r.mutable_views(0)->add_outputs(v1::OUTPUT_DEPTH);
+  EXPECT_TRUE(
+      invalid_naming(to_session_config(r, Limits{}, &config, &initial), "views[0].outputs[2]"));
+  r.mutable_views(0)->clear_outputs();
+  r.mutable_views(0)->add_outputs(static_cast<v1::Output>(9));
+  EXPECT_TRUE(
+      invalid_naming(to_session_config(r, Limits{}, &config, &initial), "views[0].outputs[0]"));
+}
+
 TEST(ValidationTest, ClientPicturesAreDecodedWithTheirDepth) {
   v1::Update u;
   std::vector<std::uint16_t> cm(48 * 20, 250);
