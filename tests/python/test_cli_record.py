@@ -132,6 +132,31 @@ class CommandLineServerTest(unittest.TestCase):
         self.assertEqual(len(data), sum(r["jpeg_bytes"] for r in records))
         self.assertEqual(data.count(b"\xff\xd8\xff"), 20)
 
+    def test_record_with_outputs_writes_matched_triplets(self):
+        from PIL import Image
+        out = self.path("truth.mjpeg")
+        result = self.cli("record", self.scenario_path, "--out", out, "--frames", "6",
+                          "--outputs", "clean,mask,depth")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        truth = self.path("truth_frames")
+        self.assertIn(f"truth={truth}", result.stdout)
+        records = self.check_jsonl(self.path("truth.jsonl"), 6, "COCKPIT", (160, 90))
+        for r in records:
+            stem = f"{int(r['frame_number']):06d}"
+            self.assertEqual(r["files"], {"jpeg": stem + ".jpg", "clean_jpeg": stem + "_clean.jpg",
+                                          "water_mask_png": stem + "_mask.png",
+                                          "depth_png": stem + "_depth.png"})
+            for field, name in r["files"].items():
+                self.assertEqual(os.path.getsize(os.path.join(truth, name)), r[field + "_bytes"])
+        last = records[-1]["files"]
+        with Image.open(os.path.join(truth, last["water_mask_png"])) as mask:
+            self.assertEqual((mask.mode, mask.size), ("L", (160, 90)))
+            self.assertGreater(mask.getextrema()[1], 8, "the rain and the glass's water show")
+        with Image.open(os.path.join(truth, last["depth_png"])) as depth:
+            self.assertEqual(depth.size, (160, 90))
+            self.assertIn(depth.mode, ("I", "I;16", "I;16B"))
+            self.assertEqual(depth.getextrema()[0], 0, "the sky")
+
     def test_record_closes_its_session_on_ctrl_c(self):
         out = self.path("interrupted.mp4")
         process = subprocess.Popen(
@@ -240,6 +265,29 @@ class CommandLineServerTest(unittest.TestCase):
         self.assertTrue(all(int(r["stats"].get("background_repeats", 0)) == 0 for r in records))
         self.assertTrue(all(r["stats"]["rain_streaks"] > 0 for r in records))
         self.assertEqual(self.session_ids(), [], "the session is closed")
+
+    def test_augment_with_outputs_writes_the_clean_picture_and_the_mask(self):
+        from PIL import Image
+        frames = self.path("truth_pictures")
+        os.makedirs(frames, exist_ok=True)
+        Image.new("RGB", (160, 90), (90, 120, 160)).save(os.path.join(frames, "a.png"))
+        out = self.path("truth_augmented")
+        result = self.cli("augment", frames, out, "--rain", "30", "--warmup", "0.5", "--fps",
+                          "10", "--outputs", "clean,mask", "--quality", "100")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertEqual(sorted(os.listdir(out)),
+                         ["a.jpg", "a_clean.jpg", "a_mask.png", "stats.jsonl"])
+        with Image.open(os.path.join(out, "a_clean.jpg")) as clean:
+            count, colour = max(clean.convert("RGB").getcolors(160 * 90))
+        # The picture, one colour, without the water (the blades may cross it).
+        self.assertGreater(count, 160 * 90 // 2)
+        self.assertTrue(all(abs(c - level) <= 2 for c, level in zip(colour, (90, 120, 160))),
+                        colour)
+        with Image.open(os.path.join(out, "a_mask.png")) as mask:
+            self.assertGreater(mask.getextrema()[1], 8)
+        result = self.cli("augment", frames, self.path("depth_refused"), "--outputs", "depth")
+        self.assertEqual(result.returncode, 1)
+        self.assertIn("the client's own", result.stderr)
 
     def test_a_picture_of_another_size_is_refused(self):
         from PIL import Image

@@ -7,6 +7,7 @@ print the server's stats.
                          [--frames N | --duration S] [--view COCKPIT] [--width W --height H]
   downpour-client watch SESSION_ID [--views COCKPIT ROAD] [--out DIR] [--frames N] [--json]
   downpour-client augment FRAMES_DIR OUT_DIR [--rain MM_H] [--speed MPS] [--wipers MODE]
+                  [--outputs clean,mask]
                           [--depth-dir DIR] [--warmup S] [--fps F] [--fov DEG]
   downpour-client close SESSION_ID
   downpour-client list
@@ -79,6 +80,15 @@ def build_parser():
     record_parser.add_argument("--stats", metavar="FILE",
                                help="the JSON lines of the frames' stats (default: the video's "
                                     "name with .jsonl)")
+    record_parser.add_argument("--outputs", metavar="LIST",
+                               help="ground truth with each frame, comma-separated: clean (the "
+                                    "frame without the water), mask (how much the water changes "
+                                    "each pixel), depth (centimetres, 16-bit PNG); each frame is "
+                                    "then also written to --truth-dir as STEM.jpg beside "
+                                    "STEM_clean.jpg, STEM_mask.png and STEM_depth.png, matched "
+                                    "pixel for pixel, and its JSON line names them")
+    record_parser.add_argument("--truth-dir", metavar="DIR",
+                               help="where --outputs go (default: the video's name with _frames)")
     record_parser.set_defaults(func=_command("record"))
 
     watch_parser = commands.add_parser(
@@ -135,6 +145,10 @@ def build_parser():
     augment_parser.add_argument("--seed", type=int, default=1)
     augment_parser.add_argument("--quality", type=int, default=92, help="JPEG quality of the "
                                                                         "frames")
+    augment_parser.add_argument("--outputs", metavar="LIST",
+                                help="ground truth beside each frame, comma-separated: clean "
+                                     "(NAME_clean.jpg, the picture without the water), mask "
+                                     "(NAME_mask.png, how much the water changes each pixel)")
     augment_parser.set_defaults(func=_command("augment"))
 
     close_parser = commands.add_parser("close", parents=[common], help="close a session")

@@ -15,9 +15,9 @@ import grpc
 from downpour.v1 import downpour_pb2 as pb
 
 from .client import DownpourClient
-from .frames import frame_record
-from .messages import (client_image, enum_name, message_dict, to_view_spec, view_value,
-                       wiper_mode_value)
+from .frames import frame_record, save_frame_files
+from .messages import (client_image, enum_name, message_dict, output_values, to_view_spec,
+                       view_value, wiper_mode_value)
 from .scenario import Scenario
 from .security import security_options
 
@@ -471,6 +471,9 @@ def _record_view(scenario, args):
         spec.width = args.width
     if args.height is not None:
         spec.height = args.height
+    if args.outputs:
+        del spec.outputs[:]
+        spec.outputs.extend(output_values(args.outputs, "--outputs"))
     return spec
 
 
@@ -488,6 +491,10 @@ def record(args):
         raise ValueError(f"--stats: {stats_path} is the video itself")
     out_dir = os.path.dirname(os.path.abspath(args.out))
     os.makedirs(out_dir, exist_ok=True)
+    truth_dir = None
+    if spec.outputs:
+        truth_dir = args.truth_dir or os.path.splitext(args.out)[0] + "_frames"
+        os.makedirs(truth_dir, exist_ok=True)
     with _connect(args) as client:
         video = VideoWriter(args.out, scenario.fps, args.codec)
         finished = False
@@ -500,8 +507,11 @@ def record(args):
                     for frame in frames:
                         if frame.view == spec.view:
                             video.write(frame.jpeg)
-                            stats_file.write(json.dumps(frame_record(frame),
-                                                        separators=(",", ":")) + "\n")
+                            line = frame_record(frame)
+                            if truth_dir is not None:
+                                line["files"] = save_frame_files(
+                                    truth_dir, f"{frame.frame_number:06d}", frame)
+                            stats_file.write(json.dumps(line, separators=(",", ":")) + "\n")
 
                 player = Player(client, scenario, info.session_id, "lockstep",
                                 frames=args.frames, duration_s=args.duration,
@@ -517,7 +527,7 @@ def record(args):
                 print(f"warning: {args.out}: {error}", file=sys.stderr)
         print(f"{player.summary()} view={enum_name(pb.View, spec.view)} "
               f"size={spec.width}x{spec.height} codec={video.codec} out={args.out} "
-              f"stats={stats_path}", flush=True)
+              f"stats={stats_path}" + (f" truth={truth_dir}" if truth_dir else ""), flush=True)
     return 0
 
 
@@ -584,7 +594,8 @@ def augment(args):
     os.makedirs(args.out_dir, exist_ok=True)
     spec = pb.ViewSpec(view=view_value(args.view, "--view"), width=width, height=height,
                        jpeg_quality=args.quality, fov_deg=args.fov,
-                       background=pb.BACKGROUND_CLIENT)
+                       background=pb.BACKGROUND_CLIENT,
+                       outputs=output_values(args.outputs, "--outputs"))
     dt = 1.0 / args.fps
     with _connect(args) as client:
         first = _picture_bytes(pictures[0])
@@ -607,11 +618,11 @@ def augment(args):
                     frames = client.step(info.session_id, dt, augment_update(
                         t, args.speed * t, args, _picture_bytes(path), depth))
                     frame = frames[0]
-                    name = os.path.splitext(os.path.basename(path))[0] + ".jpg"
-                    with open(os.path.join(args.out_dir, name), "wb") as file:
-                        file.write(frame.jpeg)
+                    stem = os.path.splitext(os.path.basename(path))[0]
+                    files = save_frame_files(args.out_dir, stem, frame)
                     record = frame_record(frame)
                     record["picture"] = os.path.basename(path)
+                    record["files"] = files
                     stats.write(json.dumps(record, separators=(",", ":")) + "\n")
         finally:
             _close_quietly(client, info.session_id)

@@ -4,7 +4,7 @@ from downpour.v1 import downpour_pb2 as pb
 from google.protobuf import json_format
 
 _PREFIXES = {"View": "VIEW_", "Mode": "MODE_", "WiperMode": "WIPER_",
-             "Background": "BACKGROUND_", "DepthEncoding": "DEPTH_"}
+             "Background": "BACKGROUND_", "DepthEncoding": "DEPTH_", "Output": "OUTPUT_"}
 # Enums whose zero is a value of its own (not "unspecified").
 _ZERO_NAMED = {"Background"}
 
@@ -57,6 +57,24 @@ def depth_encoding_value(value, field="depth_encoding"):
     return _enum_value(pb.DepthEncoding, value, field)
 
 
+# Short names of the ground truth a view can ask for (ViewSpec.outputs), beside the enum's own.
+_OUTPUT_ALIASES = {"MASK": "WATER_MASK"}
+
+
+def output_values(value, field="outputs"):
+    """Output numbers from "clean,mask,depth" (short or full names, "mask" for WATER_MASK), or from a
+    list of names or numbers; None or "" gives none."""
+    if not value:
+        return []
+    names = value.split(",") if isinstance(value, str) else list(value)
+    out = []
+    for name in names:
+        if isinstance(name, str):
+            name = _OUTPUT_ALIASES.get(name.strip().upper(), name)
+        out.append(_enum_value(pb.Output, name, field))
+    return out
+
+
 def client_image(view, image, depth=None, depth_encoding="PNG16_CM"):
     """A ClientImage: a picture (JPEG or PNG bytes, the view's size) for a view whose background is
     the client's, and optionally its depth (PNG bytes: "PNG16_CM", a 16-bit grey PNG in
@@ -80,13 +98,14 @@ def rotation(yaw_pitch_roll):
 
 def view_spec(view, width, height, quality=0, fov_deg=0.0, camera_position_m=None,
               camera_rotation_deg=None, focus_distance_m=None, aperture_mm=None,
-              exposure_s=None, background=None):
+              exposure_s=None, background=None, outputs=None):
     """A ViewSpec; camera pose (VIEW_ROAD, or a forward camera for VIEW_COCKPIT) as (x, y, z) and (yaw, pitch, roll).
 
     The lens: focus_distance_m (metres) and aperture_mm (aperture diameter, 0 = a pinhole); None
     leaves the field unset, the view's own lens. exposure_s: the shutter time that rain streaks
     show (None: 1/60 s). background: "RENDERED" (None: the server's world) or "CLIENT" (the
-    client's pictures, sent as Update.client_images).
+    client's pictures, sent as Update.client_images). outputs: the ground truth each frame brings
+    beside its JPEG (output_values: "clean,mask,depth").
     """
     spec = pb.ViewSpec(view=view_value(view), width=width, height=height,
                        jpeg_quality=quality, fov_deg=fov_deg)
@@ -102,6 +121,7 @@ def view_spec(view, width, height, quality=0, fov_deg=0.0, camera_position_m=Non
         spec.exposure_s = exposure_s
     if background is not None:
         spec.background = background_value(background)
+    spec.outputs.extend(output_values(outputs))
     return spec
 
 
