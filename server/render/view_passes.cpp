@@ -87,11 +87,12 @@ ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
   // Over a client's picture: the rain, the spray and the glass; the picture holds the world, and in
   // COCKPIT the cabin.
   Pass* picture = own(std::make_unique<ClientBackgroundPass>(shared));
+  Pass* haze = own(std::make_unique<ClientHazePass>(shared));
   auto& client = p.client_views;
   client[cockpit_view] =
-      then(then({picture, rain}, spray), {glass_water_mask, glass_water, glass_composite});
-  client[road_view] = then({picture, rain}, spray);
-  client[static_cast<int>(sim::View::kWindshield)] = {picture, glass_water_mask, glass_water,
+      then(then({picture, haze, rain}, spray), {glass_water_mask, glass_water, glass_composite});
+  client[road_view] = then({picture, haze, rain}, spray);
+  client[static_cast<int>(sim::View::kWindshield)] = {picture, haze, glass_water_mask, glass_water,
                                                       glass_composite};
   p.client_environment = {own(std::make_unique<ClientEnvironmentPass>(shared))};
   p.environment = {vehicles, street_lights, road, terrain, sky};

@@ -103,6 +103,7 @@ void fill_session_info(const session::Session& session, v1::SessionInfo* out) {
     if (v.exposure_s) spec->set_exposure_s(*v.exposure_s);
     spec->set_background(v.background == sim::Background::kClient ? v1::BACKGROUND_CLIENT
                                                                   : v1::BACKGROUND_RENDERED);
+    spec->set_haze(v.haze);
     if (v.outputs.clean) spec->add_outputs(v1::OUTPUT_CLEAN);
     if (v.outputs.water_mask) spec->add_outputs(v1::OUTPUT_WATER_MASK);
     if (v.outputs.depth) spec->add_outputs(v1::OUTPUT_DEPTH);

@@ -314,6 +314,12 @@ grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, cons
                      "must be BACKGROUND_RENDERED or BACKGROUND_CLIENT, got " +
                          std::to_string(in.background()));
   }
+  if (in.haze() && out->background != sim::Background::kClient) {
+    return invalid(field + ".haze",
+                   "is for a view over a client's pictures (BACKGROUND_CLIENT): the server's own "
+                   "world always has its haze");
+  }
+  out->haze = in.haze();
   for (int i = 0; i < in.outputs_size(); ++i) {
     const std::string f = field + ".outputs[" + std::to_string(i) + "]";
     bool* wanted = nullptr;

@@ -168,6 +168,9 @@ struct ViewSpec {
   // What lies behind the rain: the server's world, or the client's pictures (ClientImage).
   Background background = Background::kRendered;
   Outputs outputs;
+  // Over a client's picture: the server's haze over it by its depth (a simulator may draw its
+  // own fog, so off unless asked).
+  bool haze = false;
   // The driver's eye in the vehicle frame (the session's EgoGeometry): where the COCKPIT and RAIN
   // views look from without a camera of their own.
   glm::dvec3 eye_m = EgoGeometry{}.eye_m;

@@ -80,6 +80,56 @@ TEST_F(ClientBackgroundTest, ThePictureComesThroughUnchanged) {
   EXPECT_LT(testing::mean_luma(none), 0.01);
 }
 
+// The server's haze over a picture, asked for (ViewSpec::haze): what lies 400 m away takes the
+// fog's colour, what lies 20 m away little of it, and the picture's sky and a view that does not
+// ask stay as they are. With depth, and without one (the ground under the car).
+TEST_F(ClientBackgroundTest, HazeHidesWhatThePictureShowsFarAway) {
+  constexpr int kW = 320, kH = 180;
+  sim::SceneState scene = testing::parked_in_rain(10.0, 0.0, 40.0, 0.8);
+  scene.weather.fog_density = 0.3;
+  auto picture = flat_picture(kW, kH, 60);
+  // Rows bottom-up: the bottom half 20 m (left) and 400 m (right) away, the top half the sky.
+  picture->depth_m.assign(static_cast<std::size_t>(kW) * kH, 0.0f);
+  for (int y = 0; y < kH / 2; ++y) {
+    for (int x = 0; x < kW; ++x)
+      picture->depth_m[static_cast<std::size_t>(y) * kW + x] = x < kW / 2 ? 20.0f : 400.0f;
+  }
+  scene.client_images[static_cast<int>(sim::View::kRoad)] = picture;
+  sim::ViewSpec spec = picture_view(sim::View::kRoad, kW, kH);
+  const RgbaImage plain = render(spec, scene);
+  spec.haze = true;
+  const RgbaImage hazed = render(spec, scene);
+  testing::write_png(::testing::TempDir() + "client_haze.png", hazed);
+  auto change = [&](const RgbaImage& image, int x0, int y0, int x1, int y1) {
+    return testing::mean_luma(image, x0, y0, x1, y1) - 60.0 / 255.0;
+  };
+  const double sky = change(hazed, 0, 0, kW, kH / 2), near = change(hazed, 0, kH / 2, kW / 2, kH),
+               far = change(hazed, kW / 2, kH / 2, kW, kH);
+  std::printf("haze over a picture of 60: the sky %+.1f levels, 20 m %+.1f, 400 m %+.1f\n",
+              sky * 255, near * 255, far * 255);
+  EXPECT_NEAR(change(plain, 0, 0, kW, kH) * 255, 0.0, 0.5) << "a view that does not ask";
+  EXPECT_NEAR(sky * 255, 0.0, 0.5);
+  EXPECT_GT(std::abs(far) * 255, 20.0);
+  EXPECT_LT(std::abs(near) * 4, std::abs(far));
+  // Without depth the ground under the car: its far rows (near the horizon) take more haze than
+  // the near ones at the bottom.
+  picture->depth_m.clear();
+  picture->serial += 1000;
+  const RgbaImage ground = render(spec, scene);
+  const double bottom = change(ground, 0, kH - kH / 8, kW, kH);
+  double nearest_horizon = 0.0;
+  for (int y = kH / 2; y < kH; ++y) {  // the first rows under the horizon
+    const double c = change(ground, 0, y, kW, y + 1);
+    if (std::abs(c) * 255 > 1.0) {
+      nearest_horizon = c;
+      break;
+    }
+  }
+  std::printf("without depth: just under the horizon %+.1f levels, the bottom rows %+.1f\n",
+              nearest_horizon * 255, bottom * 255);
+  EXPECT_GT(std::abs(nearest_horizon), 2.0 * std::abs(bottom));
+}
+
 // A wall 2 m away over the left half of the picture, the sky over the right: the rain falls in
 // front of the sky and hardly in front of the wall (only the drops between 1.5 and 2 m).
 TEST_F(ClientBackgroundTest, RainIsHiddenBehindANearWall) {

@@ -1,7 +1,6 @@
 """The CARLA bridge against a stand-in for CARLA's Python API (no CARLA server here): what it
 sends for a world, on numbers."""
 
-import types
 import unittest
 
 import downpour_client  # noqa: F401  (puts the generated stubs on the path)
@@ -10,120 +9,7 @@ from downpour.v1 import downpour_pb2 as pb
 from downpour_carla import mapping
 from downpour_carla.bridge import CarlaBridge, CarlaOverlay
 
-XODR = "<OpenDRIVE><header revMajor=\"1\" revMinor=\"4\"/></OpenDRIVE>"
-
-
-def vec(x, y, z):
-    return types.SimpleNamespace(x=x, y=y, z=z)
-
-
-class Vehicle:
-    def __init__(self, actor_id, location, yaw, base_type="car", extent=(2.3, 0.9, 0.75),
-                 light_state=0):
-        self.id = actor_id
-        self.location, self.yaw = location, yaw
-        self.attributes = {"base_type": base_type, "number_of_wheels": "4"}
-        self.bounding_box = types.SimpleNamespace(extent=vec(*extent))
-        self.light_state = light_state
-        # Rear wheels 1.4 m behind the actor's origin, 0.8 m either side, 35 cm in radius, in
-        # centimetres as CARLA gives them (the front two first).
-        x, y, z = location
-        wheel = lambda dx, dy: types.SimpleNamespace(
-            position=vec((x + dx) * 100, (y + dy) * 100, (z + 0.35) * 100), radius=35.0)
-        self.wheels = [wheel(1.3, -0.8), wheel(1.3, 0.8), wheel(-1.4, -0.8), wheel(-1.4, 0.8)]
-
-    def get_transform(self):
-        return types.SimpleNamespace(location=vec(*self.location),
-                                     rotation=types.SimpleNamespace(pitch=0.0, yaw=self.yaw,
-                                                                    roll=0.0))
-
-    def get_velocity(self):
-        return vec(5.0, 1.0, 0.0)
-
-    def get_light_state(self):
-        return self.light_state
-
-    def get_physics_control(self):
-        return types.SimpleNamespace(wheels=self.wheels)
-
-
-class Actors(list):
-    def filter(self, pattern):
-        return Actors(a for a in self if pattern == "vehicle.*")
-
-
-class World:
-    def __init__(self, vehicles):
-        self.vehicles = Actors(vehicles)
-        self.settings = types.SimpleNamespace(synchronous_mode=False, fixed_delta_seconds=None)
-        self.ticks = 0
-
-    def get_map(self):
-        return types.SimpleNamespace(to_opendrive=lambda: XODR)
-
-    def get_weather(self):
-        return types.SimpleNamespace(cloudiness=40.0, precipitation=60.0, wind_intensity=10.0,
-                                     sun_azimuth_angle=30.0, sun_altitude_angle=15.0,
-                                     fog_density=5.0)
-
-    def get_actors(self):
-        return self.vehicles
-
-    def get_settings(self):
-        return self.settings
-
-    def apply_settings(self, settings):
-        self.settings = settings
-
-    def tick(self):
-        self.ticks += 1
-        for sensor in getattr(self, "sensors", []):
-            sensor.shoot()
-
-    def get_blueprint_library(self):
-        return types.SimpleNamespace(find=lambda kind: Blueprint(kind))
-
-    def spawn_actor(self, blueprint, transform, attach_to=None):
-        sensor = Sensor(blueprint, transform, attach_to)
-        self.sensors = getattr(self, "sensors", []) + [sensor]
-        return sensor
-
-
-class Blueprint:
-    def __init__(self, kind):
-        self.kind, self.attributes = kind, {}
-
-    def set_attribute(self, name, value):
-        self.attributes[name] = value
-
-
-# What the stand-in's cameras see: CARLA's raw BGRA, a red picture and everything 10 m away
-# (0.01 of the depth camera's 1000 m: 167772 in its 24-bit encoding).
-RED_BGRA = bytes([30, 40, 200, 255])
-TEN_M = 167772
-TEN_M_BGRA = bytes([(TEN_M >> 16) & 0xff, (TEN_M >> 8) & 0xff, TEN_M & 0xff, 255])
-
-
-class Sensor:
-    def __init__(self, blueprint, transform, parent):
-        self.blueprint, self.transform, self.parent = blueprint, transform, parent
-        self.callback, self.destroyed = None, False
-
-    def listen(self, callback):
-        self.callback = callback
-
-    def shoot(self):
-        w = int(self.blueprint.attributes["image_size_x"])
-        h = int(self.blueprint.attributes["image_size_y"])
-        pixel = RED_BGRA if self.blueprint.kind.endswith("rgb") else TEN_M_BGRA
-        self.callback(types.SimpleNamespace(width=w, height=h, raw_data=pixel * (w * h)))
-
-    def stop(self):
-        self.callback = None
-
-    def destroy(self):
-        self.destroyed = True
-
+from .standin import TEN_M, XODR, Vehicle, World
 
 class Client:
     def __init__(self):

@@ -149,6 +149,12 @@ def build_parser():
                                 help="ground truth beside each frame, comma-separated: clean "
                                      "(NAME_clean.jpg, the picture without the water), mask "
                                      "(NAME_mask.png, how much the water changes each pixel)")
+    augment_parser.add_argument("--haze", action="store_true",
+                                help="the server's haze (--fog, and the rain's) over the pictures "
+                                     "by their depth, or the ground without one; their sky is "
+                                     "left as it is")
+    augment_parser.add_argument("--fog", type=float, default=0.0, metavar="DENSITY",
+                                help="the weather's fog_density, 0 to 1 (default 0)")
     augment_parser.set_defaults(func=_command("augment"))
 
     close_parser = commands.add_parser("close", parents=[common], help="close a session")

@@ -573,6 +573,7 @@ def augment_update(sim_time_s, x_m, args, picture, depth=None):
     update.weather.rain_rate_mm_h = args.rain
     update.weather.cloudiness = args.cloudiness
     update.weather.sun_altitude_deg = args.sun
+    update.weather.fog_density = args.fog
     update.wipers.mode = wiper_mode_value(args.wipers, "--wipers")
     if args.wipers.upper().endswith("INTERMITTENT"):
         update.wipers.interval_s = 4.0
@@ -595,7 +596,7 @@ def augment(args):
     spec = pb.ViewSpec(view=view_value(args.view, "--view"), width=width, height=height,
                        jpeg_quality=args.quality, fov_deg=args.fov,
                        background=pb.BACKGROUND_CLIENT,
-                       outputs=output_values(args.outputs, "--outputs"))
+                       outputs=output_values(args.outputs, "--outputs"), haze=args.haze)
     dt = 1.0 / args.fps
     with _connect(args) as client:
         first = _picture_bytes(pictures[0])

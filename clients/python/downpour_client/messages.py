@@ -98,14 +98,15 @@ def rotation(yaw_pitch_roll):
 
 def view_spec(view, width, height, quality=0, fov_deg=0.0, camera_position_m=None,
               camera_rotation_deg=None, focus_distance_m=None, aperture_mm=None,
-              exposure_s=None, background=None, outputs=None):
+              exposure_s=None, background=None, outputs=None, haze=False):
     """A ViewSpec; camera pose (VIEW_ROAD, or a forward camera for VIEW_COCKPIT) as (x, y, z) and (yaw, pitch, roll).
 
     The lens: focus_distance_m (metres) and aperture_mm (aperture diameter, 0 = a pinhole); None
     leaves the field unset, the view's own lens. exposure_s: the shutter time that rain streaks
     show (None: 1/60 s). background: "RENDERED" (None: the server's world) or "CLIENT" (the
     client's pictures, sent as Update.client_images). outputs: the ground truth each frame brings
-    beside its JPEG (output_values: "clean,mask,depth").
+    beside its JPEG (output_values: "clean,mask,depth"). haze: over the client's pictures, the
+    server's haze by their depth (a simulator that draws its own fog leaves it off).
     """
     spec = pb.ViewSpec(view=view_value(view), width=width, height=height,
                        jpeg_quality=quality, fov_deg=fov_deg)
@@ -122,6 +123,7 @@ def view_spec(view, width, height, quality=0, fov_deg=0.0, camera_position_m=Non
     if background is not None:
         spec.background = background_value(background)
     spec.outputs.extend(output_values(outputs))
+    spec.haze = bool(haze)
     return spec
 
 

@@ -16,6 +16,32 @@ void ClientBackgroundPass::execute(const FrameContext&, const FrameResources& r)
   }
 }
 
+ClientHazePass::ClientHazePass(SharedResources& shared)
+    : shared_(shared),
+      program_("fullscreen.vert", "client_haze.frag"),
+      u_forward_(program_.uniform("u_forward")),
+      u_ground_(program_.uniform("u_ground")),
+      u_has_depth_(program_.uniform("u_has_depth")),
+      u_near_(program_.uniform("u_near")) {}
+
+bool ClientHazePass::wanted(const FrameContext& frame) const {
+  return frame.spec.haze && frame.atmosphere.fog_density > 0.0f;
+}
+
+void ClientHazePass::execute(const FrameContext& frame, const FrameResources& r) {
+  if (r.client_colour.width != r.view_colour.width ||
+      r.client_colour.height != r.view_colour.height)
+    return;  // no picture yet
+  const Camera& camera = frame.picture_camera ? *frame.picture_camera : frame.camera;
+  const GroundPlane g = ground_plane(camera, frame.scene.vehicle);
+  program_.use();
+  u_forward_.set(picture_camera(camera).forward);
+  u_ground_.set(glm::vec4(g.normal, g.camera_height_m));
+  u_has_depth_.set(r.client_depth.texture ? 1 : 0);
+  u_near_.set(camera.near_m);
+  shared_.fullscreen.draw();
+}
+
 ClientEnvironmentPass::ClientEnvironmentPass(SharedResources& shared)
     : shared_(shared),
       program_("fullscreen.vert", "client_environment.frag"),

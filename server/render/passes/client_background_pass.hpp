@@ -23,6 +23,26 @@ class ClientBackgroundPass final : public Pass {
                        {}};
 };
 
+// The server's haze over a client's picture (ViewSpec::haze): each pixel's light scattered in and
+// lost on its way, by its distance in the picture's depth, or without one by the ground under the
+// car; the picture's sky is left as it is. A pass over every pixel, so off unless a view asks.
+class ClientHazePass final : public Pass {
+ public:
+  explicit ClientHazePass(SharedResources& shared);
+  const PassDecl& decl() const override { return decl_; }
+  bool wanted(const FrameContext& frame) const override;
+  void execute(const FrameContext& frame, const FrameResources& resources) override;
+
+ private:
+  const PassDecl decl_{"client_haze",
+                       {Resource::kClientImage},
+                       {Resource::kViewColour},
+                       {DepthTest::kOff, false, Blend::kOff}};
+  SharedResources& shared_;
+  ShaderProgram program_;
+  Uniform u_forward_, u_ground_, u_has_depth_, u_near_;
+};
+
 // An environment probe's face (environment_probe.hpp) from a client-background view's picture:
 // each direction where the picture shows it, the picture's edges extended beyond it (a lens on
 // the glass turns rays to where the camera does not look); the sky where its depth says so, or

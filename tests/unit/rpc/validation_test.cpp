@@ -617,6 +617,17 @@ TEST(ValidationTest, OutputsAreTakenOnceEach) {
       invalid_naming(to_session_config(r, Limits{}, &config, &initial), "views[0].outputs[0]"));
 }
 
+TEST(ValidationTest, HazeIsForViewsOverPictures) {
+  v1::CreateSessionRequest r = good_request();
+  r.mutable_views(0)->set_haze(true);
+  session::SessionConfig config;
+  sim::Update initial;
+  EXPECT_TRUE(invalid_naming(to_session_config(r, Limits{}, &config, &initial), "views[0].haze"));
+  r.mutable_views(0)->set_background(v1::BACKGROUND_CLIENT);
+  ASSERT_TRUE(to_session_config(r, Limits{}, &config, &initial).ok());
+  EXPECT_TRUE(config.views[0].haze);
+}
+
 TEST(ValidationTest, ClientPicturesAreDecodedWithTheirDepth) {
   v1::Update u;
   std::vector<std::uint16_t> cm(48 * 20, 250);
