@@ -414,9 +414,10 @@ json measure_pipeline(const sim::Scenario& scenario, const sim::ViewSpec& spec, 
 // A client-background COCKPIT (issue 29): each lockstep step brings a picture, a JPEG of the
 // scene's own dry COCKPIT frame at the view's size (quality 85, as a simulator's camera might
 // send), decoded on the submitting thread as the server decodes it on the call's. Steps a second
-// with 3 in flight and serially, and the decode's median and share of a step.
+// with 3 in flight and serially, and the decode's median and share of a step; with `outputs`,
+// also with 3 in flight asking for the clean frame and the water mask (ViewSpec::outputs).
 json measure_client_background(const sim::Scenario& scenario, const sim::ViewSpec& rendered,
-                               int frames, double warm_s) {
+                               int frames, double warm_s, bool outputs) {
   std::string jpeg;
   {
     auto renderer = render::Renderer::create(g_renderer);
@@ -453,6 +454,11 @@ json measure_client_background(const sim::Scenario& scenario, const sim::ViewSpe
   j["picture_bytes"] = jpeg.size();
   j["pipelined"] = measure_pipeline(scenario, spec, frames, 3, warm_s, attach);
   j["serial"] = measure_pipeline(scenario, spec, frames, 1, warm_s, attach);
+  if (outputs) {
+    sim::ViewSpec with = spec;
+    with.outputs.clean = with.outputs.water_mask = true;
+    j["pipelined_with_outputs"] = measure_pipeline(scenario, with, frames, 3, warm_s, attach);
+  }
   j["passes_ms"] = measure_passes(scenario, spec, std::min(frames, 30), warm_s,
                                   [&](const sim::SceneState& state) {
                                     sim::Update u;
@@ -552,6 +558,9 @@ int main(int argc, char** argv) {
   app.add_flag("--client-background", client_background,
                "only COCKPIT over a client's pictures (a JPEG each step) at each size: lockstep "
                "steps a second and the decode's share");
+  bool outputs = false;
+  app.add_flag("--outputs", outputs,
+               "with --client-background: also with the clean frame and the water mask asked for");
   CLI11_PARSE(app, argc, argv);
 
   if (check_renderer) {
@@ -584,7 +593,7 @@ int main(int argc, char** argv) {
         return 2;
       }
       json r = measure_client_background(
-          scenario, sim::view_spec(sim::View::kCockpit, width, height), frames, warm_s);
+          scenario, sim::view_spec(sim::View::kCockpit, width, height), frames, warm_s, outputs);
       r["size"] = size;
       out["client_background"].push_back(r);
     }

@@ -13,6 +13,7 @@ SessionCost estimate_cost(const SessionConfig& config) {
     const double pixels = static_cast<double>(v.width) * v.height;
     cost.pixel_rate += pixels * fps;
     cost.memory_bytes += pixels * kBytesPerViewPixel;
+    if (v.outputs.any()) cost.memory_bytes += pixels * kBytesPerGroundTruthPixel;
   }
   return cost;
 }

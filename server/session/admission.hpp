@@ -23,6 +23,10 @@ constexpr double kLockstepNominalFps = 30.0;
 // the water's surface on the GPU (some 3 MB in heavy rain) and the environment probe (1.2 MB).
 constexpr double kBytesPerViewPixel = 20.0;
 constexpr double kBytesPerSession = 20.0 * 1024 * 1024;
+// A view that asks for ground truth (sim::Outputs), per pixel, counted from what it holds: the
+// clean frame's texture, two readback buffers and the encoder's copy (16 bytes), the depth's two
+// readback buffers, its distances and its centimetres (14).
+constexpr double kBytesPerGroundTruthPixel = 30.0;
 
 SessionCost estimate_cost(const SessionConfig& config);
 

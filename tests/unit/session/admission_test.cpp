@@ -24,6 +24,11 @@ TEST(AdmissionTest, CostIsPixelsTimesRateOverTheViewsAndLockstepCountsItsExpecte
   EXPECT_DOUBLE_EQ(ls.pixel_rate, 1280.0 * 720 * 120.0);  // the rate its client said it steps at
   const SessionCost none = estimate_cost(views(sim::Mode::kLockstep, 0.0, {{1280, 720}}));
   EXPECT_DOUBLE_EQ(none.pixel_rate, 1280.0 * 720 * kLockstepNominalFps);
+  // Ground truth holds more per pixel.
+  SessionConfig truth = views(sim::Mode::kLockstep, 0.0, {{1280, 720}});
+  truth.views[0].outputs.depth = true;
+  EXPECT_DOUBLE_EQ(estimate_cost(truth).memory_bytes,
+                   none.memory_bytes + 1280.0 * 720 * kBytesPerGroundTruthPixel);
 }
 
 TEST(AdmissionTest, RefusalNamesTheBudgetAndWhatIsFree) {
