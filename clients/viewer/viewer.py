@@ -1013,13 +1013,20 @@ class ViewerHandler(BaseHTTPRequestHandler):
             log(f"slow request: {getattr(self, 'command', '')} {path} took {took:.1f} s")
 
 
+class ViewerServer(ThreadingHTTPServer):
+    # Every request is a connection of its own (HTTP/1.0): a page opens some fifty a second (two
+    # views' frames, its controls, its polls). socketserver's backlog of 5 overflows when a loaded
+    # machine is slow to accept, and a connection refused that way waits for the browser's
+    # retries (1, 2, 4, 8 s: a page unheard for 15 s loses its drive).
+    request_queue_size = 128
+    daemon_threads = True
+
+
 def make_server(frames, port, host="127.0.0.1", directory=None, follower=None, drive=None):
     handler = type("BoundViewerHandler", (ViewerHandler,), {
         "frames": frames, "directory": directory, "follower": follower, "drive": drive,
         "loopback_only": host in ("127.0.0.1", "localhost", "::1")})
-    server = ThreadingHTTPServer((host, port), handler)
-    server.daemon_threads = True
-    return server
+    return ViewerServer((host, port), handler)
 
 
 def main(argv=None):

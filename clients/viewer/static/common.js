@@ -16,16 +16,20 @@ const Downpour = (() => {
     return node;
   }
 
+  // A request that has not answered in this long is given up (and its caller tries again), so that
+  // one lost request never stalls what waits on it.
+  const REQUEST_TIMEOUT_MS = 4000;
+
   async function getJSON(path) {
-    const response = await fetch(path, {cache: "no-store"});
+    const response = await fetch(path, {cache: "no-store", signal: AbortSignal.timeout(REQUEST_TIMEOUT_MS)});
     if (!response.ok) throw new Error(path + ": HTTP " + response.status);
     return response.json();
   }
 
-  async function postJSON(path, body) {
+  async function postJSON(path, body, timeoutMs = REQUEST_TIMEOUT_MS) {
     const response = await fetch(path, {
       method: "POST", headers: {"Content-Type": "application/json"},
-      body: JSON.stringify(body || {}), keepalive: true,
+      body: JSON.stringify(body || {}), keepalive: true, signal: AbortSignal.timeout(timeoutMs),
     });
     const value = await response.json().catch(() => ({}));
     if (!response.ok) throw new Error(value.error || path + ": HTTP " + response.status);

@@ -101,7 +101,8 @@
     $("start").hidden = true; $("stop").hidden = false;
     banner("Creating a realtime session…", true);
     try {
-      const d = await D.postJSON("/api/drive/start", {width: 480, height: 270, fps: 20});
+      // (A session may take a while to create on a loaded server.)
+      const d = await D.postJSON("/api/drive/start", {width: 480, height: 270, fps: 20}, 30000);
       if (d.state !== "driving") throw new Error(d.error || "the session was not created");
       sessionId = d.session_id; state = "driving";
       setSliders(d.weather);
