@@ -101,6 +101,11 @@ class OverlayThroughTheServerTest(unittest.TestCase):
         rainy = Image.open(io.BytesIO(last.jpeg)).convert("RGB")
         clean = Image.open(io.BytesIO(last.clean_jpeg)).convert("RGB")
         mask = Image.open(io.BytesIO(last.water_mask_png))
+        look = os.environ.get("DOWNPOUR_LOOK_DIR")  # to look at: the picture and what came back
+        if look:
+            for name, image in (("picture", picture), ("rainy", rainy), ("clean", clean),
+                                ("mask", mask.point(lambda m: min(255, 4 * m)))):
+                image.save(os.path.join(look, f"carla_overlay_{name}.png"))
         self.assertEqual((rainy.size, clean.size, mask.size, mask.mode),
                          ((W, H), (W, H), (W, H), "L"))
         # The clean frame is CARLA's picture (JPEG'd three times: the server's, the overlay's and
