@@ -4,10 +4,17 @@
 // Sky radiance along a world direction, without clouds. Kept free of pow(): on llvmpipe each
 // pow is a log and an exp per channel, and this runs for every sky pixel.
 vec3 sky_gradient(vec3 dir) {
-  float up = clamp(dir.z, 0.0, 1.0);
-  vec3 sky = mix(frame.sky_horizon.rgb, frame.sky_zenith.rgb, sqrt(up));
-  // Below the horizon: the horizon colour, a little darker (distant ground under haze).
-  sky = dir.z < 0.0 ? frame.sky_horizon.rgb * (1.0 - 0.15 * clamp(-dir.z * 4.0, 0.0, 1.0)) : sky;
+  float up = clamp(dir.z, 0.0, 1.0), rise = sqrt(up);
+  vec3 sky = mix(frame.sky_horizon.rgb, frame.sky_zenith.rgb, rise);
+  // The clear sky's scattering by the sun's place (sky_table.hpp): what it adds to the gradient.
+  vec2 sun_xy = frame.sun_dir.xy;
+  float toward = dot(dir.xy, sun_xy) *
+                 inversesqrt(max(dot(dir.xy, dir.xy) * dot(sun_xy, sun_xy), 1e-12));
+  const vec2 size = vec2(SKY_TABLE_WIDTH, SKY_TABLE_HEIGHT);
+  vec2 at = vec2(0.5 - 0.5 * toward, rise) * ((size - 1.0) / size) + 0.5 / size;
+  sky = max(sky + textureLod(sky_tex, at, 0.0).rgb, 0.0);
+  // Below the horizon: the horizon's colour, a little darker (distant ground under haze).
+  sky *= 1.0 - 0.15 * clamp(-dir.z * 4.0, 0.0, 1.0);
   float sun = max(dot(dir, frame.sun_dir.xyz), 0.0);
   float s2 = sun * sun, s4 = s2 * s2, s8 = s4 * s4;
   float disc = smoothstep(0.9990, 0.9996, sun) * (1.0 - frame.overcast);

@@ -29,6 +29,7 @@
 #include "server/render/passes/spray_pass.hpp"
 #include "server/render/render_session.hpp"
 #include "server/render/render_targets.hpp"
+#include "server/render/sky_table.hpp"
 #include "server/render/view_passes.hpp"
 #include "server/render/world.hpp"
 #include "server/sim/pose.hpp"
@@ -70,6 +71,7 @@ struct Renderer::Impl {
   double glass_layer_widening = 1.0;
   std::optional<std::array<std::vector<glm::vec3>, EnvironmentProbe::kFaces>> fixed_environment;
 
+  std::unique_ptr<SkyTable> sky;
   TransientTargets transients;
   std::array<bool, kResourceCount> written{};  // this frame's
   bool profiling = false;
@@ -317,6 +319,7 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
 
   impl->shared = make_shared_resources();
+  impl->sky = std::make_unique<SkyTable>();
   impl->worlds.get(nullptr);  // the built-in track's, before the first frame
   impl->block = std::make_unique<FrameBlockBuffer>();
   impl->lamps = std::make_unique<FrameLamps>();
@@ -467,6 +470,7 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
   const Mirror mirror =
       mirror_under(scene.roads ? *scene.roads : *sim::built_in_roads(), scene.vehicle);
   m.block->upload_view(frame, water_block(frame, mirror, reflection));
+  m.sky->show(frame.atmosphere);
   for (Pass* pass : frame_passes)
     m.timed(pass->decl().name, [&] { m.run_pass(*pass, frame, s, resources); });
   const bool fixed = m.fixed_environment && spec.view == sim::View::kCockpit && !client;

@@ -42,10 +42,12 @@ Atmosphere atmosphere_from(const sim::Weather& w) {
   // shadows show at dusk.
   const float sky_dim = 1.0f - 0.7f * low_sun;
   const float exposure = 1.0f + 0.9f * low_sun;
-  a.sky_zenith = glm::mix(clear_zenith, grey_zenith, a.overcast) * level * sky_dim * exposure;
-  a.sky_horizon =
-      glm::mix(glm::mix(clear_horizon, clear_horizon * warm, low_sun), grey_horizon, a.overcast) *
-      level * sky_dim * exposure;
+  const float sky_level = level * sky_dim * exposure;
+  a.clear_zenith = clear_zenith * sky_level;
+  a.clear_horizon = glm::mix(clear_horizon, clear_horizon * warm, low_sun) * sky_level;
+  a.sky_zenith = glm::mix(a.clear_zenith, grey_zenith * sky_level, a.overcast);
+  a.sky_horizon = glm::mix(a.clear_horizon, grey_horizon * sky_level, a.overcast);
+  a.sun_altitude_deg = alt_deg;
 
   // The beam through the air: reddened along its path, by the air mass (Kasten and Young) beyond
   // a 25-degree sun's; its disc sets over the horizon's last degree and a half.

@@ -13,6 +13,11 @@ struct Atmosphere {
   glm::vec3 sun_radiance{1.0f};               // direct light reaching the ground
   glm::vec3 sky_zenith{0.3f, 0.5f, 0.9f};
   glm::vec3 sky_horizon{0.7f, 0.8f, 0.95f};
+  // The clear part of that gradient (before the clouds' grey is mixed in), which the scattered
+  // sky's table replaces (sky_table.hpp); and the sun's altitude it is computed for (degrees).
+  glm::vec3 clear_zenith{0.2f, 0.42f, 0.85f};
+  glm::vec3 clear_horizon{0.68f, 0.8f, 0.95f};
+  float sun_altitude_deg = 90.0f;
   glm::vec3 ambient{0.3f};  // light from the whole sky on an upward surface
   glm::vec3 fog_colour{0.7f};
   float fog_density = 0.0f;  // extinction per metre

@@ -17,6 +17,9 @@ namespace downpour::render {
 #define DOWNPOUR_TEXTURE_UNITS(X)                                                                  \
   X(kNoise, 1, sampler2D, noise_tex, "value noise, 4 frequencies in rgba, repeating")              \
   X(kAsphalt, 2, sampler2D, asphalt_tex, "asphalt relief: rgb normal, a height (seed 003, 3.1)")   \
+  X(kSky, 3, sampler2D, sky_tex,                                                                   \
+    "the clear sky by the sun's place, less the frame's gradient (sky_table.hpp): columns from "   \
+    "the sun's azimuth round, rows sqrt(sin elevation)")                                           \
   X(kEnvironment, 4, samplerCube, environment_tex,                                                 \
     "the world outside the windshield from its centre, world axes, linear radiance with the sun "  \
     "and lamps at their energy, mipmapped (environment_probe.hpp)")                                \
@@ -141,7 +144,9 @@ inline constexpr unsigned kLampBlockBinding = 1;
 #define DOWNPOUR_ARRAY_SIZES(X)                                                            \
   X(kMaxLamps, 64, MAX_LAMPS, "lamps a frame knows: the lamp block, the lamp map's boxes") \
   X(kMaxGlows, 96, MAX_GLOWS, "lamp glows drawn, the strongest (lamp_glow_pass.hpp)")      \
-  X(kWiperBlades, 2, WIPER_BLADES, "wiper blades (wiper_blades.hpp)")
+  X(kWiperBlades, 2, WIPER_BLADES, "wiper blades (wiper_blades.hpp)")                      \
+  X(kSkyTableWidth, 32, SKY_TABLE_WIDTH, "the sky's table: columns (sky_scattering.hpp)")  \
+  X(kSkyTableHeight, 24, SKY_TABLE_HEIGHT, "and rows")
 #define DOWNPOUR_ARRAY_SIZE_CONSTANT(name, size, glsl, what) inline constexpr int name = size;
 DOWNPOUR_ARRAY_SIZES(DOWNPOUR_ARRAY_SIZE_CONSTANT)
 #undef DOWNPOUR_ARRAY_SIZE_CONSTANT

@@ -63,7 +63,7 @@ TEST(ShaderInterfaceTest, TheGeneratedGlslDeclaresWhatTheCppLists) {
   ++sizes;
   DOWNPOUR_ARRAY_SIZES(EXPECT_SIZE)
 #undef EXPECT_SIZE
-  EXPECT_EQ(sizes, 3);
+  EXPECT_EQ(sizes, 5);
 }
 
 // Whether `text` declares a uniform array sized by a number: "uniform TYPE NAME [ DIGITS ]", with
