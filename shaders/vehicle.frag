@@ -48,6 +48,12 @@ void main() {
     float on = material == MATERIAL_INDICATOR_LEFT ? u_lamps.z : u_lamps.w;
     emit = lens(amber, 5000.0, 1.0, 3.0) * on;
   }
+  // Wet paint and trim (the weather's wetness): water in the finish's roughness deepens its colour,
+  // as on the wet ground, and a film of it makes the sheen a mirror.
+  float wet = frame.wetness * float(material == MATERIAL_BODY || material == MATERIAL_TRIM);
+  albedo *= mix(1.0, 0.72, wet);
+  gloss = mix(gloss, 1.0, wet);
+  r0 = mix(r0, 0.05, wet);
   // The lamps' light on the ground as what falls on this face: whole on a roof, a tenth on a side
   // (the street lights shine down; the cars' own beams are the ego car's, per pixel).
   vec3 light = diffuse_light(n) + lamp_ground(v_world) * (0.1 + 0.9 * max(outward.z, 0.0)) +

@@ -133,13 +133,39 @@ TEST_F(VehicleClassesTest, TheEgoCarIsAsLongAsItsSizeAndItsDriverSeesFromItsEye)
   auto bonnet_top = [&](const RgbaImage& image) {
     for (int y = 0; y < kHeight; ++y) {
       const std::size_t i = (static_cast<std::size_t>(y) * kWidth + kWidth / 2) * 4;
-      if (image.pixels[i] > image.pixels[i + 1] + 20) return y;
+      if (image.pixels[i] > image.pixels[i + 1] + 10)
+        return y;  // (wet paint: deep red, a sheen of sky)
     }
     return kHeight;
   };
   std::printf("the bonnet's top in the middle column: eye at %.2f m row %d, at %.2f m row %d\n",
               eye.z, bonnet_top(low), eye.z + 0.12, bonnet_top(high));
   EXPECT_GT(bonnet_top(high), bonnet_top(low) + 5);
+}
+
+// Rain wets the paint: the car's red, against the sky that lights it, darkens by more than the
+// light does (the chase camera's view of the ego car's rear, the same full cloud, dry and in
+// 10 mm/h, no streaks to confuse it). The red channel: the paint's own, where the sheen adds grey.
+TEST_F(VehicleClassesTest, TheRainDarkensThePaint) {
+  auto body_over_sky = [&](double rain_mm_h) {
+    sim::SceneState s = dry_scene();
+    s.weather.cloudiness = 1.0;
+    s.weather.rain_rate_mm_h = rain_mm_h;
+    s.spray.reset();
+    const RgbaImage image = render(sim::view_spec(sim::View::kRoad, 320, 180), s);
+    auto red = [&](int x0, int y0, int x1, int y1) {
+      double sum = 0.0;
+      for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x)
+          sum += image.pixels[(static_cast<std::size_t>(y) * 320 + x) * 4];
+      }
+      return sum / ((x1 - x0) * (y1 - y0));
+    };
+    return red(145, 108, 175, 120) / red(0, 5, 320, 20);
+  };
+  const double dry = body_over_sky(0.0), wet = body_over_sky(10.0);
+  std::printf("the paint's red against the sky's: %.3f dry, %.3f in 10 mm/h\n", dry, wet);
+  EXPECT_LT(wet, 0.93 * dry);
 }
 
 }  // namespace
