@@ -328,12 +328,14 @@ void main() {
   float fresnel = schlick(cos_v, 0.02);
   // Gravel and grass off the pavement never mirror: a wet sheen at most. On the pavement the
   // mirror strengthens and sharpens as the water rises over the texture: streaked along the view
-  // on a film (the texture's peaks still break it), clear on a puddle.
+  // on a thin film (the texture's peaks still break it), clear once 1.2 mm stand over them (a
+  // flooded road, a puddle).
   float smooth_water = film;
   float k = fresnel * mix(0.2 + 0.3 * fill * (1.0 - verge), 1.0, max(smooth_water, pool));
   vec3 refl = sky_gradient(r);
 #ifdef ROAD_MIRROR
-  refl = mix(refl, mirrored(v_world, r, refl, 1.0 - pool), step(1e-3, smooth_water));
+  float streak = 1.0 - smoothstep(0.3, 1.2, water.y);
+  refl = mix(refl, mirrored(v_world, r, refl, streak), step(1e-3, smooth_water));
   refl += lamp_glints(v_world, n_refl, view) * max(smooth_water, pool);
 #endif
   // A sheen of the sun on the film, broader than the sun in the mirror.
