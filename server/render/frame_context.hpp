@@ -47,6 +47,8 @@ struct FrameContext {
   // Where a face of the environment is drawn from a client's picture: the camera the picture was
   // taken from (the view's); null elsewhere (the frame's own camera is the picture's).
   const Camera* picture_camera = nullptr;
+  // The camera a client's picture was taken from, wherever this frame draws.
+  const Camera& picture_camera_or_own() const { return picture_camera ? *picture_camera : camera; }
 
   const sim::WindshieldState& water() const { return stepped().windshield; }
   const sim::RainState& rain() const { return stepped().rain; }

@@ -195,7 +195,7 @@ struct Renderer::Impl {
         break;
       case Resource::kClientImage: {
         // The picture's depth made the view's reversed-Z with its camera's near plane.
-        const Camera& camera = f.picture_camera ? *f.picture_camera : f.camera;
+        const Camera& camera = f.picture_camera_or_own();
         const RenderSession::Impl::ClientPicture& p = session.upload_client_image(
             f.spec.view, f.scene.client_images[static_cast<std::size_t>(f.spec.view)],
             camera.near_m);

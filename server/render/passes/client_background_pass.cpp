@@ -32,7 +32,7 @@ void ClientHazePass::execute(const FrameContext& frame, const FrameResources& r)
   if (r.client_colour.width != r.view_colour.width ||
       r.client_colour.height != r.view_colour.height)
     return;  // no picture yet
-  const Camera& camera = frame.picture_camera ? *frame.picture_camera : frame.camera;
+  const Camera& camera = frame.picture_camera_or_own();
   const GroundPlane g = ground_plane(camera, frame.scene.vehicle);
   program_.use();
   u_forward_.set(picture_camera(camera).forward);
@@ -56,7 +56,7 @@ ClientEnvironmentPass::ClientEnvironmentPass(SharedResources& shared)
 
 void ClientEnvironmentPass::execute(const FrameContext& frame, const FrameResources& r) {
   // The picture's camera: the view's, not the face's that this draws from.
-  const Camera& view_camera = frame.picture_camera ? *frame.picture_camera : frame.camera;
+  const Camera& view_camera = frame.picture_camera_or_own();
   const PictureCamera c = picture_camera(view_camera);
   const GroundPlane g = ground_plane(view_camera, frame.scene.vehicle);
   program_.use();
