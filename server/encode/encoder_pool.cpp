@@ -98,7 +98,10 @@ void EncoderPool::run() {
     {
       std::lock_guard lock(mutex_);
       --reserved_;
-      if (spare_buffers_.size() < kMaxSpareBuffers) spare_buffers_.push_back(std::move(job.rgba));
+      for (std::vector<std::uint8_t>* used : {&job.rgba, &job.clean}) {
+        if (!used->empty() && spare_buffers_.size() < kMaxSpareBuffers)
+          spare_buffers_.push_back(std::move(*used));
+      }
     }
     if (on_idle_slot_) on_idle_slot_();
   }

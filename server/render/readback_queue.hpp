@@ -45,7 +45,10 @@ class ReadbackQueue {
       std::vector<std::uint8_t> pixels;
       GroundTruthPixels truth;
       try {
-        pixels = buffers_(static_cast<std::size_t>(e.readback.width) * e.readback.height * 4);
+        const std::size_t bytes =
+            static_cast<std::size_t>(e.readback.width) * e.readback.height * 4;
+        pixels = buffers_(bytes);
+        if (e.readback.outputs.needs_clean()) truth.clean = buffers_(bytes);
         renderer_.finish(e.readback, pixels, &truth);
       } catch (const std::exception& error) {
         fail(std::move(e.payload), error.what());

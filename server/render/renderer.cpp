@@ -426,7 +426,7 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
 
   const Camera camera = make_camera(spec, scene.vehicle, &scene.weather);
   // Ground truth: the clean frame (for itself or the water mask) and the depth.
-  const bool wants_clean = spec.outputs.clean || spec.outputs.water_mask;
+  const bool wants_clean = spec.outputs.needs_clean();
   if (spec.outputs.any() && !target->truth) {
     target->truth =
         std::make_unique<GroundTruthTarget>(spec.width, spec.height, target->depth.id());
@@ -606,9 +606,9 @@ void Renderer::finish(const PendingReadback& pending, std::vector<std::uint8_t>&
   read_buffer(target.pbo[pending.slot].id(), out.size(),
               [&](const void* data) { std::memcpy(out.data(), data, out.size()); });
   if (!truth) return;
-  truth->clean.clear();
-  truth->depth_m.clear();
-  if (pending.outputs.clean || pending.outputs.water_mask) {
+  if (!pending.outputs.needs_clean()) truth->clean.clear();
+  if (!pending.outputs.depth) truth->depth_m.clear();
+  if (pending.outputs.needs_clean()) {
     truth->clean.resize(pixels * 4);
     read_buffer(target.truth->clean_pbo[pending.slot].id(), truth->clean.size(),
                 [&](const void* data) { std::memcpy(truth->clean.data(), data, pixels * 4); });

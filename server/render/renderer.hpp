@@ -60,7 +60,8 @@ struct PendingReadback {
 };
 
 // A view's ground truth read back with its pixels (sim::Outputs), rows bottom-up; each empty where
-// the view did not ask for it.
+// the view did not ask for it. finish() fills the buffers it is given (a pool's, already of the
+// right size, are not reallocated).
 struct GroundTruthPixels {
   std::vector<std::uint8_t> clean;  // RGBA8: the frame without its water (clean or water mask)
   std::vector<float> depth_m;       // along the view's axis; 0 where nothing was drawn (the sky)

@@ -39,24 +39,28 @@ const std::vector<glm::vec3>& SkyTable::scattered(int quarter_degrees) {
 }
 
 void SkyTable::show(const Atmosphere& a) {
+  // What the table depends on: the same air as the last frame's (a session's every frame, as a
+  // rule) leaves it as it is.
+  const int quarter_degrees =
+      static_cast<int>(std::lround(std::clamp(a.sun_altitude_deg, -20.0f, 90.0f) * 4.0f));
+  const Shown key{quarter_degrees, a.overcast, a.clear_zenith, a.clear_horizon};
+  if (shown_ && *shown_ == key) return;
+  shown_ = key;
   const float clear = 1.0f - a.overcast;
   texels_.assign(static_cast<std::size_t>(kSkyTableWidth) * kSkyTableHeight * 4, 0.0f);
   if (clear > 0.0f) {
-    const std::vector<glm::vec3>& sky = scattered(
-        static_cast<int>(std::lround(std::clamp(a.sun_altitude_deg, -20.0f, 90.0f) * 4.0f)));
-    // The gradient it replaces, and the scale that gives the scattered sky the gradient's mean
-    // luminance over the table: the exposure stays the frame's; the colours and where the light
-    // lies come from the scattering.
-    std::vector<glm::vec3> gradient(sky.size());
+    const std::vector<glm::vec3>& sky = scattered(quarter_degrees);
+    // The gradient it replaces (its rows' v is the shader's sqrt(sin elevation)), and the scale
+    // that gives the scattered sky the gradient's mean luminance over the table: the exposure
+    // stays the frame's; the colours and where the light lies come from the scattering.
+    const auto gradient = [&](std::size_t k) {
+      const float v = static_cast<float>(k / kSkyTableWidth) / (kSkyTableHeight - 1);
+      return glm::mix(a.clear_horizon, a.clear_zenith, v);
+    };
     float sky_sum = 0.0f, gradient_sum = 0.0f;
-    for (int j = 0; j < kSkyTableHeight; ++j) {
-      const float v = static_cast<float>(j) / (kSkyTableHeight - 1);
-      for (int i = 0; i < kSkyTableWidth; ++i) {
-        const std::size_t k = static_cast<std::size_t>(j) * kSkyTableWidth + i;
-        gradient[k] = glm::mix(a.clear_horizon, a.clear_zenith, v);
-        sky_sum += luminance(sky[k]);
-        gradient_sum += luminance(gradient[k]);
-      }
+    for (std::size_t k = 0; k < sky.size(); ++k) {
+      sky_sum += luminance(sky[k]);
+      gradient_sum += luminance(gradient(k));
     }
     const float scale = sky_sum > 0.0f ? gradient_sum / sky_sum : 0.0f;
     // Round a low sun the scattered sky is tens of times brighter than elsewhere: softly capped
@@ -67,14 +71,12 @@ void SkyTable::show(const Atmosphere& a) {
       glm::vec3 c = sky[k] * scale;
       const float l = luminance(c) / std::max(cap, 1e-6f);
       c /= std::sqrt(1.0f + l * l);
-      const glm::vec3 d = (c - gradient[k]) * clear;
+      const glm::vec3 d = (c - gradient(k)) * clear;
       texels_[4 * k] = d.x, texels_[4 * k + 1] = d.y, texels_[4 * k + 2] = d.z;
     }
   }
-  if (texels_ == shown_) return;
   glTextureSubImage2D(texture_.id(), 0, 0, 0, kSkyTableWidth, kSkyTableHeight, GL_RGBA, GL_FLOAT,
                       texels_.data());
-  shown_ = texels_;
 }
 
 }  // namespace downpour::render

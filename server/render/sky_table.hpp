@@ -6,6 +6,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -19,15 +20,22 @@ class SkyTable {
  public:
   SkyTable();  // bound to its unit
   // The table for this frame's air (the scattering computed once per quarter degree of the sun's
-  // altitude, some 3 ms, and kept), uploaded where it changed.
+  // altitude, some 3 ms, and kept), made and uploaded where the air changed.
   void show(const Atmosphere& atmosphere);
 
  private:
+  // What the table shown was made from.
+  struct Shown {
+    int quarter_degrees = 0;
+    float overcast = 0.0f;
+    glm::vec3 clear_zenith{0.0f}, clear_horizon{0.0f};
+    bool operator==(const Shown&) const = default;
+  };
   const std::vector<glm::vec3>& scattered(int quarter_degrees);
   Texture texture_;
   std::map<int, std::vector<glm::vec3>> cache_;
   std::vector<float> texels_;
-  std::vector<float> shown_;
+  std::optional<Shown> shown_;
 };
 
 }  // namespace downpour::render

@@ -145,6 +145,8 @@ struct Outputs {
   bool water_mask = false;  // how much the water changes each pixel (needs the clean frame)
   bool depth = false;       // distance along the view's axis
   bool any() const { return clean || water_mask || depth; }
+  // Whether the clean frame is read back: for itself, or to make the mask from.
+  bool needs_clean() const { return clean || water_mask; }
   bool operator==(const Outputs&) const = default;
 };
 
