@@ -18,7 +18,7 @@ PY=/usr/bin/python3  # Debian's interpreter, with python3-grpcio
 
 PACKAGES=(cmake ninja-build g++ ccache pkg-config
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
-  libturbojpeg0-dev libspdlog-dev libglm-dev libcli11-dev nlohmann-json3-dev libpng-dev libpugixml-dev
+  libturbojpeg0-dev libspdlog-dev libglm-dev libcli11-dev nlohmann-json3-dev libtinygltf-dev libpng-dev libpugixml-dev
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
   libgtest-dev libgmock-dev libbenchmark-dev glslang-tools prometheus-cpp-dev
   python3 python3-grpcio python3-protobuf python3-pil openssl

@@ -12,10 +12,10 @@
 #include <CLI/CLI.hpp>
 
 #include "bench/stats.hpp"
+#include "server/model/default_models.hpp"
 #include "server/render/cpu/atmosphere.hpp"
 #include "server/render/cpu/cabin_tiles.hpp"
 #include "server/render/cpu/camera.hpp"
-#include "server/render/cpu/vehicle_geometry.hpp"
 #include "server/render/passes/rain_pass.hpp"
 #include "server/sim/pose.hpp"
 #include "server/sim/scenario.hpp"
@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
       render::RainLayerInputs in = render::rain_layer_inputs(frame, layer_h, occluders, lamps);
       // The cabin's tiles, as the pass has them (made once per camera there).
       if (cabin.empty()) {
-        cabin = render::cabin_tiles(render::build_cockpit_interior(state.glass), camera, layer_w,
+        cabin = render::cabin_tiles(model::default_cabin(state.glass).mesh, camera, layer_w,
                                     layer_h, render::RainLayer::kTile);
       }
       in.cabin_tiles = cabin;

@@ -9,7 +9,7 @@ void main() {
   vec3 view = normalize(frame.camera_pos.xyz - v_world);
   n = dot(n, view) < 0.0 ? -n : n;
   // Dark plastic lit mostly by the sky through the glass: the silhouettes frame the view.
-  vec3 albedo = int(v_uv.x + 0.5) == MATERIAL_BODY ? vec3(0.05) : vec3(0.028, 0.028, 0.03);
+  vec3 albedo = int(v_uv.x + 0.5) == MATERIAL_BODY ? vec3(0.05) : trim_colour(v_uv.y, vec3(0.028, 0.028, 0.03));
   vec3 light = frame.ambient.rgb * (0.35 + 0.4 * max(n.z, 0.0)) + frame.sun_radiance.rgb * 0.15 * max(dot(n, frame.sun_dir.xyz), 0.0);
   float sheen = schlick(dot(n, view), 0.03) * 0.3;
   out_colour = vec4(to_display(albedo * light + frame.sky_horizon.rgb * sheen), 1.0);

@@ -112,3 +112,10 @@ vec3 from_display(vec3 d) {
   vec3 c = d * d;
   return c / max(1.0 - 0.15 * c, 0.05);
 }
+
+// A trim colour a model carries in uv.y (model/vehicle_model.hpp's pack_trim_colour): 0 none (the
+// given colour), else 1 + 5 bits each of linear red, green and blue.
+vec3 trim_colour(float code, vec3 otherwise) {
+  int c = int(code + 0.5) - 1;
+  return c < 0 ? otherwise : vec3((c >> 10) & 31, (c >> 5) & 31, c & 31) / 31.0;
+}

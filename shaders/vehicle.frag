@@ -2,7 +2,7 @@
 #include "common.glsl"
 in vec3 v_world;
 in vec3 v_normal;
-in vec2 v_uv;  // x material id (MATERIAL_*, interface.glsl)
+in vec2 v_uv;  // x material id (MATERIAL_*, interface.glsl), y a trim colour (trim_colour)
 in vec4 v_fog;
 out vec4 out_colour;
 uniform vec3 u_body_colour;
@@ -37,7 +37,7 @@ void main() {
     emit = lens(red, 100.0 * u_lamps.x + 1500.0 * u_lamps.y,
                 0.5 * u_lamps.x + 1.2 * u_lamps.y, 1.5 + 1.5 * u_lamps.y);
   } else if (material == MATERIAL_TRIM) {
-    albedo = vec3(0.03);
+    albedo = trim_colour(v_uv.y, vec3(0.03));
     gloss = 0.2;
   } else if (material == MATERIAL_HEADLAMP || material == MATERIAL_STREET_LAMP) {
     albedo = vec3(0.45);

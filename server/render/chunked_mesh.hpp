@@ -7,7 +7,7 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
-#include "server/render/cpu/mesh_data.hpp"
+#include "server/model/mesh_data.hpp"
 #include "server/render/gl/gl_objects.hpp"
 
 namespace downpour::render {

@@ -1,6 +1,6 @@
 // The ego car's outer shape where the simulation needs it (rain that lands on the car), in the
 // vehicle frame: x forward from the rear axle, y left, z up from the ground. The renderer's car
-// (render/cpu/vehicle_geometry.cpp) is built to the same figures, so that what lands on it is where
+// (model/default_models.cpp) is built to the same figures, so that what lands on it is where
 // it is drawn.
 #pragma once
 

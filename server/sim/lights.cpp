@@ -42,6 +42,9 @@ void VehicleMotion::observe(const VehicleState& state, double now_s, const Light
     braking = false;
   }
   if (!known || dt > 1e-6) {
+    const double forward = glm::dot(state.velocity_mps, heading);
+    if (known) rolled_m += 0.5 * (forward_mps + forward) * dt;
+    forward_mps = forward;
     velocity_mps = state.velocity_mps;
     time_s = now_s;
   }

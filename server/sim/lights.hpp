@@ -49,13 +49,18 @@ bool indicator_lit(double sim_time_s, const LightsConfig& config = {});
 
 // Whether a vehicle slows, from its velocity at two updates dt_s apart: for automatic brake
 // lights. Keeps braking while it stands after braking.
+// Also how far it has rolled, for its wheels' turn: forward speed integrated over the updates.
 struct VehicleMotion {
   glm::dvec3 velocity_mps{0.0};
   double time_s = 0.0;
   bool known = false;
   bool braking = false;
+  double forward_mps = 0.0;  // along its heading at the last update
+  double rolled_m = 0.0;     // at time_s, from its first update
   // Takes the vehicle's state at time_s (sim time).
   void observe(const VehicleState& state, double time_s, const LightsConfig& config = {});
+  // How far it has rolled by a later time, on at its last speed.
+  double rolled_at(double now_s) const { return rolled_m + forward_mps * (now_s - time_s); }
 };
 
 struct StreetLight {

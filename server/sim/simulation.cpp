@@ -73,6 +73,17 @@ void Simulation::publish() {
     state_.tires[t] = {water * 1e3, road_.standing_m(xy) * 1e3, road_.state_of(water)};
   }
   state_.ego_place = ego_place(surface_->roads(), glm::dvec2(state_.vehicle.position_m));
+  roll(state_);
+}
+
+void Simulation::roll(SceneState& scene) const {
+  scene.ego_rolled_m = ego_motion_.rolled_at(scene.sim_time_s);
+  scene.traffic_rolled_m.resize(scene.traffic.size());
+  for (std::size_t i = 0; i < scene.traffic.size(); ++i) {
+    const auto it = traffic_motion_.find(scene.traffic[i].id);
+    scene.traffic_rolled_m[i] =
+        it != traffic_motion_.end() ? it->second.rolled_at(scene.sim_time_s) : 0.0;
+  }
 }
 
 void Simulation::apply(const Update& update) {
@@ -164,6 +175,7 @@ SceneState Simulation::inputs_after(double dt_s) const {
   for (double carry = carry_s_ + dt_s; whole_sub_step_due(carry); carry -= config_.sub_step_s)
     ++inputs.sub_steps;
   inputs.sim_time_s = static_cast<double>(inputs.sub_steps) * config_.sub_step_s;
+  roll(inputs);
   return inputs;
 }
 

@@ -69,6 +69,10 @@ struct SceneState {
   // in the order of `traffic`. Flashing lamps are lit at the frame's time (indicator_lit).
   VehicleLights ego_lights;
   std::vector<VehicleLights> traffic_lights;
+  // How far each vehicle has rolled at sim_time_s (VehicleMotion): its wheels' turn times their
+  // radius. The ego car's, and the traffic's in the order of `traffic`.
+  double ego_rolled_m = 0.0;
+  std::vector<double> traffic_rolled_m;
   // The roads the session drives on (road_network.hpp): the built-in track's unless the session
   // brought its own.
   std::shared_ptr<const RoadNetwork> roads;
@@ -111,6 +115,7 @@ class Simulation {
   VehicleMotion ego_motion_;
   std::unordered_map<std::uint32_t, VehicleMotion> traffic_motion_;
   void resolve_lights(bool vehicle_moved, bool traffic_moved);
+  void roll(SceneState& scene) const;  // its *_rolled_m at its sim_time_s
   std::uint64_t seed_;
   double carry_s_ = 0.0;
   WiperMotion wipers_;

@@ -3,7 +3,7 @@
 namespace downpour::sim {
 
 const VehicleLayout& vehicle_layout(VehicleClass c) {
-  // A passenger car (the ego car's shape, render/cpu/vehicle_geometry.hpp); a rigid truck with a
+  // A passenger car (the ego car's shape, model/default_models.hpp); a rigid truck with a
   // 7.5 m wheelbase and a box body; a 12 m city bus; a motorbike with its rider.
   static const VehicleLayout kCar{
       {4.6, 1.8, 1.47}, -0.95, {3.6, 0.62, 0.7}, {-0.95, 0.7, 0.78}, 0.33};

@@ -83,6 +83,73 @@ TEST_F(VehicleClassesTest, EachClassStandsAsLongAndTallAsItsSize) {
   }
 }
 
+// Each class's model close up, from ahead and behind on its left, by day (written to
+// DOWNPOUR_TEST_IMAGES as model_<class>_<front|rear>.png, to be looked at): its wheels turn as it
+// rolls and nothing else of it moves. A tenth of a turn changes the wheels' pixels (the spokes
+// move) and leaves the body's as they were.
+TEST_F(VehicleClassesTest, EachModelsWheelsTurnAsItRolls) {
+  const sim::SceneState base = dry_scene();
+  const sim::Track& track = sim::Track::built_in();
+  const double s0 = track.project(glm::dvec2(base.vehicle.position_m), 50.0).s;
+  for (const sim::VehicleClass c : {sim::VehicleClass::kCar, sim::VehicleClass::kTruck,
+                                    sim::VehicleClass::kBus, sim::VehicleClass::kMotorbike}) {
+    const sim::VehicleLayout& layout = sim::vehicle_layout(c);
+    sim::SceneState s = base;
+    const double mid = 25.0;
+    const sim::TrackFrame f = track.at(s0 + mid - 0.5 * layout.size_m.x - layout.rear_m);
+    sim::TrafficVehicle v;
+    v.id = 4;  // dark red
+    v.vehicle_class = c;
+    v.size_m = layout.size_m;
+    const glm::dvec2 xy = glm::dvec2(f.position) + f.left * track.lane_centre(0);
+    v.state.position_m = {xy.x, xy.y, track.surface_height(s0 + mid, track.lane_centre(0))};
+    v.state.rotation.yaw_deg = glm::degrees(f.heading_rad);
+    s.traffic = {v};
+    s.traffic_lights = {sim::VehicleLights{}};
+    s.traffic_rolled_m = {0.0};
+    // From the ego car's frame: ahead of the vehicle and to its right, looking back at it; and
+    // behind it, looking ahead.
+    const double reach = 0.5 * layout.size_m.x + 1.2 * layout.size_m.z + 2.5;
+    const double off = -1.5 * layout.size_m.y - 1.5;
+    for (const bool ahead : {true, false}) {
+      const glm::dvec3 eye(mid + (ahead ? reach : -reach), off, 1.0 + 0.3 * layout.size_m.z);
+      const double yaw = ahead ? 180.0 - 35.0 : 35.0;
+      const sim::ViewSpec spec = posed_view(sim::View::kRoad, 640, 360, eye, yaw, -5.0, 34.0);
+      const RgbaImage still = render(spec, s);
+      const std::string name = std::string("model_") + std::to_string(static_cast<int>(c)) +
+                               (ahead ? "_front.png" : "_rear.png");
+      if (const char* dir = std::getenv("DOWNPOUR_TEST_IMAGES"))
+        testing::write_png(std::string(dir) + "/" + name, still);
+      if (ahead) continue;
+      sim::SceneState rolled = s;
+      rolled.traffic_rolled_m = {0.1 * 2.0 * 3.14159265 * layout.wheel_radius_m};
+      const RgbaImage turned = render(spec, rolled);
+      // The changed pixels lie where the wheels are drawn: under the wheel tops, near the ground.
+      const Camera camera = make_camera(spec, s.vehicle);
+      const glm::dmat4 to_world = sim::vehicle_to_world(v.state);
+      const glm::vec4 top_clip =
+          camera.projection * camera.view *
+          glm::vec4(to_world * glm::dvec4(0.0, 0.0, 2.05 * layout.wheel_radius_m, 1.0));
+      const float wheel_top_row = (0.5f - top_clip.y / top_clip.w * 0.5f) * 360.0f;
+      int changed = 0, above = 0;
+      for (int y = 0; y < 360; ++y) {
+        for (int x = 0; x < 640; ++x) {
+          const std::size_t i = (static_cast<std::size_t>(y) * 640 + x) * 4;
+          int d = 0;
+          for (int k = 0; k < 3; ++k)
+            d = std::max(d, std::abs(turned.pixels[i + k] - still.pixels[i + k]));
+          if (d > 12) ++changed, above += y < wheel_top_row - 25.0f;
+        }
+      }
+      std::printf(
+          "class %d: a tenth of a turn changes %d pixels, %d of them well above the wheels\n",
+          static_cast<int>(c), changed, above);
+      EXPECT_GT(changed, 30) << static_cast<int>(c);
+      EXPECT_LE(above, changed / 20) << static_cast<int>(c);
+    }
+  }
+}
+
 // The changed pixels' columns (x0, x1) and rows (y0, y1) of an image against another.
 glm::ivec4 changed_box(const RgbaImage& image, const RgbaImage& base) {
   glm::ivec4 box(image.width, -1, image.height, -1);

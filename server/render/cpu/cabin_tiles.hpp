@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "server/model/mesh_data.hpp"
 #include "server/render/cpu/camera.hpp"
-#include "server/render/cpu/mesh_data.hpp"
 
 namespace downpour::render {
 

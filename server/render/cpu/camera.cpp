@@ -6,7 +6,6 @@
 #include <glm/trigonometric.hpp>
 
 #include "server/render/cpu/atmosphere.hpp"
-#include "server/render/cpu/vehicle_geometry.hpp"
 #include "server/sim/pose.hpp"
 
 namespace downpour::render {

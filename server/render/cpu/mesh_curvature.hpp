@@ -6,7 +6,7 @@
 
 #include <glm/vec2.hpp>
 
-#include "server/render/cpu/mesh_data.hpp"
+#include "server/model/mesh_data.hpp"
 
 namespace downpour::render {
 

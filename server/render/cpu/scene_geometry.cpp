@@ -9,7 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include "server/render/cpu/mesh_curvature.hpp"
-#include "server/render/cpu/vehicle_geometry.hpp"
+#include "server/render/cpu/shader_interface.hpp"
 
 namespace downpour::render {
 namespace {

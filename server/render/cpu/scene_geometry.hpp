@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "server/render/cpu/mesh_data.hpp"
+#include "server/model/mesh_data.hpp"
 #include "server/sim/lights.hpp"
 #include "server/sim/road_network.hpp"
 

@@ -96,8 +96,9 @@ namespace downpour::render {
     "column l: the lamp map's ring l, as road_water_rings: xy lower-left corner, z 1 / "      \
     "side, w cell (m)")
 
-// Material ids, carried in a mesh vertex's uv.x (vehicle_geometry.hpp, scene_geometry.cpp) and
-// read by vehicle.frag and cockpit.frag: X(C++ name, id, GLSL constant, what).
+// Material ids, carried in a mesh vertex's uv.x (model/default_models.cpp, model/gltf_model.cpp,
+// scene_geometry.cpp) and read by vehicle.frag and cockpit.frag: X(C++ name, id, GLSL constant,
+// what).
 #define DOWNPOUR_MATERIALS(X)                                             \
   X(kBody, 0, MATERIAL_BODY, "paint, or the cabin's dashboard")           \
   X(kGlass, 1, MATERIAL_GLASS, "windows")                                 \

@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-#include "server/render/cpu/mesh_data.hpp"
+#include "server/model/mesh_data.hpp"
 #include "server/sim/lights.hpp"
 #include "server/sim/road_network.hpp"
 

@@ -150,6 +150,13 @@ void Mesh::draw() const {
   glDrawElements(GL_TRIANGLES, index_count_, GL_UNSIGNED_INT, nullptr);
 }
 
+void Mesh::draw(std::uint32_t first_index, std::uint32_t count) const {
+  if (count == 0) return;
+  glBindVertexArray(vao_.id());
+  glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(count), GL_UNSIGNED_INT,
+                 reinterpret_cast<const void*>(static_cast<std::uintptr_t>(first_index) * 4u));
+}
+
 FullscreenTriangle::FullscreenTriangle() {
   GLuint vao = 0;
   glCreateVertexArrays(1, &vao);

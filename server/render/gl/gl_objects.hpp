@@ -11,7 +11,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-#include "server/render/cpu/mesh_data.hpp"
+#include "server/model/mesh_data.hpp"
 #include "server/render/gl/gl.hpp"
 
 namespace downpour::render {
@@ -107,6 +107,8 @@ class Mesh {
   Mesh() = default;
   explicit Mesh(const MeshData& data);
   void draw() const;
+  // Indices [first_index, first_index + count) alone.
+  void draw(std::uint32_t first_index, std::uint32_t count) const;
   bool empty() const { return index_count_ == 0; }
   std::size_t triangles() const { return static_cast<std::size_t>(index_count_) / 3; }
   glm::vec3 bounds_min{0.0f};

@@ -1,20 +1,20 @@
 #include "server/render/passes/cockpit_pass.hpp"
 
-#include "server/render/cpu/vehicle_geometry.hpp"
+#include "server/model/default_models.hpp"
 
 namespace downpour::render {
 
 CockpitPass::CockpitPass(SharedResources&)
     : program_("mesh.vert", "cockpit.frag"),
       u_model_(program_.uniform("u_model")),
-      interior_(build_cockpit_interior(built_for_)) {}
+      interior_(model::default_cabin(built_for_).mesh) {}
 
 void CockpitPass::execute(const FrameContext& frame, const FrameResources&) {
   // The cabin is built around the scene's glass (remade in the rare case that it changes).
   const sim::GlassConfig& glass = frame.scene.glass;
-  if (!same_cockpit_interior(glass, built_for_)) {
+  if (!model::same_cabin(glass, built_for_)) {
     built_for_ = glass;
-    interior_ = Mesh(build_cockpit_interior(built_for_));
+    interior_ = Mesh(model::default_cabin(built_for_).mesh);
   }
   program_.use();
   u_model_.set(frame.vehicle_to_world);

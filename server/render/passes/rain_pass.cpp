@@ -7,11 +7,11 @@
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "server/model/default_models.hpp"
 #include "server/render/cpu/cabin_tiles.hpp"
 #include "server/render/cpu/client_background.hpp"
 #include "server/render/cpu/light_set.hpp"
 #include "server/render/cpu/shader_interface.hpp"
-#include "server/render/cpu/vehicle_geometry.hpp"
 #include "server/sim/car_body.hpp"
 #include "server/sim/pose.hpp"
 
@@ -224,7 +224,7 @@ const std::vector<std::uint8_t>& RainPass::cabin_tiles_for(const FrameContext& f
   for (const CabinTiles& t : cabin_tiles_) {
     if (t.width == width && t.height == height && t.eye == c.position_vehicle &&
         t.axes == c.axes_vehicle && t.tan_x == c.tan_half_fov_x && t.tan_y == c.tan_half_fov_y &&
-        same_cockpit_interior(t.glass, g))
+        model::same_cabin(t.glass, g))
       return t.hidden;
   }
   // Every driver's camera of the sessions at once, as a rule (a view's camera is fixed for its
@@ -234,7 +234,7 @@ const std::vector<std::uint8_t>& RainPass::cabin_tiles_for(const FrameContext& f
   if (cabin_tiles_.size() >= kKept) cabin_tiles_.erase(cabin_tiles_.begin());
   cabin_tiles_.push_back(
       {width, height, c.position_vehicle, c.axes_vehicle, c.tan_half_fov_x, c.tan_half_fov_y, g,
-       cabin_tiles(build_cockpit_interior(g), c, width, height, RainLayer::kTile)});
+       cabin_tiles(model::default_cabin(g).mesh, c, width, height, RainLayer::kTile)});
   return cabin_tiles_.back().hidden;
 }
 

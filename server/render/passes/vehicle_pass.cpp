@@ -1,11 +1,14 @@
 #include "server/render/passes/vehicle_pass.hpp"
 
 #include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/constants.hpp>
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "server/model/default_models.hpp"
 #include "server/render/cpu/light_set.hpp"
-#include "server/render/cpu/vehicle_geometry.hpp"
 #include "server/sim/pose.hpp"
 #include "server/sim/vehicle_class.hpp"
 
@@ -16,16 +19,33 @@ VehiclePass::VehiclePass(SharedResources&)
       u_model_(program_.uniform("u_model")),
       u_body_colour_(program_.uniform("u_body_colour")),
       u_lamps_(program_.uniform("u_lamps")),
-      u_head_(program_.uniform("u_head")),
-      hull_(build_car_hull()),
-      upper_(build_car_upper()),
-      truck_(build_truck()),
-      bus_(build_bus()),
-      motorbike_(build_motorbike()) {}
+      u_head_(program_.uniform("u_head")) {
+  for (const sim::VehicleClass c : {sim::VehicleClass::kCar, sim::VehicleClass::kTruck,
+                                    sim::VehicleClass::kBus, sim::VehicleClass::kMotorbike}) {
+    near_.emplace_back(model::default_vehicle(c, model::Detail::kFull));
+    far_.emplace_back(model::default_vehicle(c, model::Detail::kFar));
+  }
+}
 
-void VehiclePass::prepare(const glm::mat4& model, const glm::vec3& colour,
-                          const sim::VehicleLights& lights, bool flash_on) {
+VehiclePass::Drawn::Drawn(const model::VehicleModel& m)
+    : mesh(m.mesh), fixed(m.fixed_index_count), bonnet(m.bonnet_index_count), wheels(m.wheels) {}
+
+void VehiclePass::draw(const Drawn& d, const glm::mat4& model, double rolled_m, bool bonnet_only) {
   u_model_.set(model);
+  d.mesh.draw(0, bonnet_only ? d.bonnet : d.fixed);
+  if (bonnet_only) return;
+  for (const model::Wheel& w : d.wheels) {
+    const double turns = rolled_m / (2.0 * glm::pi<double>() * w.radius_m);
+    const auto angle = static_cast<float>(2.0 * glm::pi<double>() * (turns - std::floor(turns)));
+    u_model_.set(glm::translate(
+        glm::rotate(glm::translate(model, w.centre), angle, glm::vec3(0.0f, 1.0f, 0.0f)),
+        -w.centre));
+    d.mesh.draw(w.first_index, w.index_count);
+  }
+}
+
+void VehiclePass::prepare(const glm::vec3& colour, const sim::VehicleLights& lights,
+                          bool flash_on) {
   u_body_colour_.set(colour);
   const bool heads =
       lights.headlights == sim::Headlights::kLow || lights.headlights == sim::Headlights::kHigh;
@@ -46,10 +66,13 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
   // Seen from outside, at the session's size (the cabin keeps the default car's).
   const glm::vec3 ego_scale =
       cockpit ? glm::vec3(1.0f) : glm::vec3(frame.scene.ego.size_m / sim::EgoGeometry{}.size_m);
-  prepare(glm::scale(frame.vehicle_to_world, ego_scale), glm::vec3(0.42f, 0.05f, 0.04f),
-          shown_lights(frame.scene.ego_lights, weather), flash_on);
-  hull_.draw();
-  if (!cockpit) upper_.draw();
+  prepare(glm::vec3(0.42f, 0.05f, 0.04f), shown_lights(frame.scene.ego_lights, weather), flash_on);
+  const auto car = static_cast<std::size_t>(sim::VehicleClass::kCar);
+  draw(near_[car], glm::scale(frame.vehicle_to_world, ego_scale), frame.scene.ego_rolled_m,
+       cockpit);
+  // A vehicle under 40 pixels tall is drawn from its model for the distance.
+  const float pixels_per_radian = 0.5f * static_cast<float>(frame.spec.height) /
+                                  static_cast<float>(frame.camera.tan_half_fov_y);
   const glm::mat4 view_proj = frame.camera.projection * frame.camera.view;
   static const glm::vec3 palette[] = {{0.75f, 0.75f, 0.78f}, {0.05f, 0.06f, 0.08f},
                                       {0.1f, 0.2f, 0.45f},   {0.55f, 0.55f, 0.5f},
@@ -69,22 +92,14 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
     const sim::VehicleLights lights = i < frame.scene.traffic_lights.size()
                                           ? frame.scene.traffic_lights[i]
                                           : sim::VehicleLights{};
-    prepare(model, palette[other.id % 6], shown_lights(lights, weather), flash_on);
-    switch (other.vehicle_class) {
-      case sim::VehicleClass::kTruck:
-        truck_.draw();
-        break;
-      case sim::VehicleClass::kBus:
-        bus_.draw();
-        break;
-      case sim::VehicleClass::kMotorbike:
-        motorbike_.draw();
-        break;
-      case sim::VehicleClass::kCar:
-        hull_.draw();
-        upper_.draw();
-        break;
-    }
+    prepare(palette[other.id % 6], shown_lights(lights, weather), flash_on);
+    const double rolled =
+        i < frame.scene.traffic_rolled_m.size() ? frame.scene.traffic_rolled_m[i] : 0.0;
+    const float distance = glm::length(centre - frame.camera.position);
+    const bool small =
+        static_cast<float>(other.size_m.z) * pixels_per_radian < 40.0f * std::max(distance, 0.1f);
+    const auto c = static_cast<std::size_t>(other.vehicle_class);
+    draw(small ? far_[c] : near_[c], model, rolled, false);
   }
 }
 

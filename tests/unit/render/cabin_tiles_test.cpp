@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "server/render/cpu/vehicle_geometry.hpp"
+#include "server/model/default_models.hpp"
 #include "server/sim/types.hpp"
 
 namespace downpour::render {
@@ -19,7 +19,7 @@ TEST(CabinTilesTest, TheDashboardAndRoofAreHiddenTheRoadAheadClearWithEdgesBetwe
   const Camera camera = make_camera(spec, sim::VehicleState{});
   const sim::GlassConfig glass;
   const std::vector<std::uint8_t> hidden =
-      cabin_tiles(build_cockpit_interior(glass), camera, kWidth, kHeight, kTile);
+      cabin_tiles(model::default_cabin(glass).mesh, camera, kWidth, kHeight, kTile);
   const int tiles_x = kWidth / kTile, tiles_y = (kHeight + kTile - 1) / kTile;
   ASSERT_EQ(hidden.size(), static_cast<std::size_t>(tiles_x * tiles_y));
   auto at = [&](int tx, int ty) { return hidden[ty * tiles_x + tx]; };  // rows bottom-up

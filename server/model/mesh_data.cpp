@@ -1,4 +1,4 @@
-#include "server/render/cpu/mesh_data.hpp"
+#include "server/model/mesh_data.hpp"
 
 #include <algorithm>
 #include <cmath>
