@@ -166,12 +166,12 @@ fuzz() {
   CXX=clang++-14 CC=clang-14 configure "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDOWNPOUR_FUZZ=ON \
     -DDOWNPOUR_BUILD_TESTS=OFF -DDOWNPOUR_BUILD_BENCH=OFF
   cmake --build "$dir" -j "$(nproc)" --target request_fuzzer scenario_fuzzer simulation_fuzzer opendrive_fuzzer \
-    image_fuzzer
+    image_fuzzer gltf_fuzzer
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-  # All five at once (libFuzzer runs one process each); a crash leaves its input as
+  # All six at once (libFuzzer runs one process each); a crash leaves its input as
   # build-fuzz/<target>-crash-* and fails the run.
   local pids=() target
-  for target in request scenario simulation opendrive image; do
+  for target in request scenario simulation opendrive image gltf; do
     local work="$dir/corpus/$target" extra=()
     mkdir -p "$work"
     [ "$target" = scenario ] && extra=("$ROOT/clients/scenarios")
@@ -181,7 +181,7 @@ fuzz() {
     pids+=($!)
   done
   local failed=0 i=0
-  for target in request scenario simulation opendrive image; do
+  for target in request scenario simulation opendrive image gltf; do
     if wait "${pids[$i]}"; then
       echo "fuzz $target: $(grep -E '^stat::number_of_executed_units' "$dir/$target.log" |
         awk '{print $2}') inputs in $seconds s, no crash"

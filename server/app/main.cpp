@@ -187,6 +187,15 @@ std::shared_ptr<rpc::RoadNetworks> road_networks(const ServerConfig& config) {
   return networks;
 }
 
+// The vehicle and cabin models sessions may name (from --models-dir).
+std::shared_ptr<model::ModelLibrary> model_library(const ServerConfig& config) {
+  model::ModelLimits limits;
+  limits.max_bytes = static_cast<std::size_t>(config.model_max_mb) << 20;
+  limits.max_triangles = static_cast<std::size_t>(config.model_max_triangles);
+  if (!config.models_dir.empty()) spdlog::info("models from {}", config.models_dir);
+  return std::make_shared<model::ModelLibrary>(config.models_dir, limits);
+}
+
 // Probes that cannot speak TLS get the health service alone, in plaintext, on its own port
 // (--health-listen; none if empty). Built before reflection is enabled (a process-wide plugin),
 // so it offers nothing else. False (logged) where the port cannot be had.
@@ -396,7 +405,7 @@ int main(int argc, char** argv) {
   app::admit_for_renderer(*config, scheduler, registry, metrics.get());
 
   rpc::DownpourService service(registry, scheduler, app::request_limits(*config), auth,
-                               app::road_networks(*config));
+                               app::road_networks(*config), app::model_library(*config));
   service.set_identity(app::kVersion, config->advertise);
   if (!config->advertise.empty()) spdlog::info("advertising {} to clients", config->advertise);
 

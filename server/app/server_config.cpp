@@ -179,6 +179,19 @@ void add_road_options(CLI::App& app, ServerConfig& c) {
                  "beyond 64)")
       ->check(CLI::Range(1, 64))
       ->envname("DOWNPOUR_MAX_MESSAGE_MB");
+  app.add_option("--models-dir", c.models_dir,
+                 "glTF 2.0 vehicle and cabin models (.glb, .gltf) that sessions may name "
+                 "(ego.body_model, ego.cabin_model, TrafficVehicle.model)")
+      ->check(CLI::ExistingDirectory)
+      ->envname("DOWNPOUR_MODELS_DIR");
+  app.add_option("--model-max-mb", c.model_max_mb,
+                 "the largest model file, with the buffers beside it that it names, MiB")
+      ->check(CLI::Range(1, 1024))
+      ->envname("DOWNPOUR_MODEL_MAX_MB");
+  app.add_option("--model-max-triangles", c.model_max_triangles,
+                 "the most triangles a model may have")
+      ->check(CLI::Range(1000, 10'000'000))
+      ->envname("DOWNPOUR_MODEL_MAX_TRIANGLES");
   app.add_option("--max-road-km", c.max_road_km,
                  "the most road a session's network may have, km (every road's length added)")
       ->check(CLI::Range(0.1, 1000.0))

@@ -57,6 +57,11 @@ struct ServerConfig {
   // directory (empty: none); and the largest request (inline OpenDRIVE text counts), MiB.
   std::string maps_dir;
   int max_message_mb = 1;
+  // Vehicle and cabin models (model/model_library.hpp) sessions may name, in this directory
+  // (empty: none); the largest file (MiB) and the most triangles one may hold.
+  std::string models_dir;
+  int model_max_mb = 64;
+  int model_max_triangles = 500'000;
   // A session's road network: the most road (km, every road's length added), which bounds the
   // time and memory its scene takes to build (on the CreateSession call's thread, not the render
   // loop's: about 40 ms and 3 MiB a km of six-lane road here).

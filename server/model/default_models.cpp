@@ -8,16 +8,14 @@
 
 #include <glm/geometric.hpp>
 
+#include "server/model/materials.hpp"
 #include "server/model/shapes.hpp"
-#include "server/render/cpu/shader_interface.hpp"
 #include "server/sim/car_body.hpp"
 #include "server/sim/vehicle_class.hpp"
 
 namespace downpour::model {
 
 namespace {
-
-namespace material = render::material;
 
 const Look kPaint{material::kBody};
 const Look kGlass{material::kGlass};

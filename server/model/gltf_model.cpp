@@ -22,13 +22,12 @@
 #include <glm/mat4x4.hpp>
 #include "server/model/tinygltf.hpp"
 
-#include "server/render/cpu/shader_interface.hpp"
+#include "server/model/materials.hpp"
+#include "server/sim/file_name.hpp"
 
 namespace downpour::model {
 
 namespace {
-
-namespace material = render::material;
 
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(),
@@ -93,14 +92,6 @@ void check_json_depth(std::string_view json, int max_depth) {
   }
 }
 
-// A bare file name: letters, digits, '_', '-', '.' and ' ', not starting with '.'.
-bool bare_name(std::string_view name) {
-  if (name.empty() || name.size() > 255 || name.front() == '.') return false;
-  return std::all_of(name.begin(), name.end(), [](unsigned char c) {
-    return std::isalnum(c) || c == '_' || c == '-' || c == '.' || c == ' ';
-  });
-}
-
 // tinygltf's file system: only bare names in `dir`, within the byte budget left.
 struct Files {
   std::filesystem::path dir;
@@ -111,7 +102,7 @@ struct Files {
     const std::string prefix = dir.string() + "/";
     if (path.rfind(prefix, 0) != 0) return std::nullopt;
     const std::string name = path.substr(prefix.size());
-    if (!bare_name(name)) return std::nullopt;
+    if (!sim::plain_file_name(name, 255)) return std::nullopt;
     return dir / name;
   }
 };
@@ -273,8 +264,10 @@ Shade shade_of(const tinygltf::Model& m, int index, ModelKind kind) {
     return {material::kIndicatorRight};
   if (has(name, {"tail", "brake"})) return {material::kLamp};
   if (has(name, {"paint", "body"})) return {material::kBody};
+  // Its own colour; glTF's default, white, is the built-in dark trim.
   const std::vector<double>& c = mat.pbrMetallicRoughness.baseColorFactor;
-  if (c.size() >= 3) return {material::kTrim, pack_trim_colour(c[0], c[1], c[2])};
+  if (c.size() >= 3 && !(c[0] == 1.0 && c[1] == 1.0 && c[2] == 1.0))
+    return {material::kTrim, pack_trim_colour(c[0], c[1], c[2])};
   return {};
 }
 
@@ -603,7 +596,7 @@ const char* material_name(float id) {
 
 std::array<double, 3> unpack_trim_colour(float code) {
   const int c = static_cast<int>(code + 0.5f) - 1;
-  if (c < 0) return {0.03, 0.03, 0.03};  // vehicle.frag's trim
+  if (c < 0) return {1.0, 1.0, 1.0};  // glTF's default: the reader's built-in trim
   return {(c >> 10 & 31) / 31.0, (c >> 5 & 31) / 31.0, (c & 31) / 31.0};
 }
 
@@ -622,7 +615,7 @@ struct Writer {
     const auto c = unpack_trim_colour(colour);
     m.pbrMetallicRoughness.baseColorFactor = {c[0], c[1], c[2], 1.0};
     m.pbrMetallicRoughness.metallicFactor = 0.0;
-    m.pbrMetallicRoughness.roughnessFactor = id == render::material::kGlass ? 0.05 : 0.5;
+    m.pbrMetallicRoughness.roughnessFactor = id == material::kGlass ? 0.05 : 0.5;
     if (colour > 0.0f) m.name = "trim_" + std::to_string(g.materials.size());
     g.materials.push_back(m);
     return materials[key] = static_cast<int>(g.materials.size() - 1);
@@ -722,6 +715,24 @@ std::string write_glb(const VehicleModel& model) {
   for (std::size_t i = 0; i < model.wheels.size(); ++i) {
     const std::string name = "wheel_" + std::to_string(i);
     add_node(name, w.mesh(model, model.wheels[i].first_index, model.wheels[i].index_count, name));
+  }
+  if (model.windshield) {  // a cabin's: where the simulated glass lies, as the reader finds it
+    const sim::GlassConfig g = glass_of(*model.windshield);
+    const double inset = g.inset_mm(g.height_mm);
+    VehicleModel quad;
+    const glm::vec3 n(g.normal());
+    const glm::vec2 uv(material::kGlass, 0.0f);
+    for (const glm::dvec2 p :
+         {glm::dvec2(0.0, 0.0), glm::dvec2(g.bottom_width_mm, 0.0),
+          glm::dvec2(g.bottom_width_mm - inset, g.height_mm), glm::dvec2(inset, g.height_mm)})
+      quad.mesh.add_vertex(glm::vec3(g.to_vehicle(p)), n, uv);
+    quad.mesh.add_quad(0, 1, 2, 3);
+    const int mesh = w.mesh(quad, 0, 6, "windshield");
+    tinygltf::Material glass = w.g.materials[w.g.meshes[mesh].primitives[0].material];
+    glass.name = "windshield";
+    w.g.materials.push_back(glass);
+    w.g.meshes[mesh].primitives[0].material = static_cast<int>(w.g.materials.size() - 1);
+    add_node("windshield", mesh);
   }
   tinygltf::Buffer buffer;
   buffer.data = std::move(bin);

@@ -10,7 +10,7 @@
 //   "window" windows, "tyre"/"tire"/"rubber" tyres, "headlamp"/"headlight", "indicator_left" and
 //   "indicator_right" (or "blinker_"/"turn_"), "tail"/"brake" the red lamps, "paint"/"body" the
 //   paint (the vehicle's own colour, or the cabin's dashboard); any other is trim of its base
-//   colour;
+//   colour (glTF's default, white, is the built-in dark trim);
 // - wheels: nodes whose names begin with "wheel"; each turns about its lateral axis through the
 //   centre of its bounds, its radius half its height.
 // Textures, skins, morph targets and animations are not read. The model is placed as the vehicle

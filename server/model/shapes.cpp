@@ -6,8 +6,8 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "server/model/materials.hpp"
 #include "server/model/vehicle_model.hpp"
-#include "server/render/cpu/shader_interface.hpp"
 
 namespace downpour::model {
 
@@ -147,7 +147,7 @@ void add_wheel(render::MeshData& m, const glm::vec3& c, float radius, float widt
                int spokes, float rim_colour, int around) {
   const int count = around;
   const float half = 0.5f * width, rim = 0.64f * radius, shoulder = 0.04f * radius / 0.33f;
-  const glm::vec2 tyre(render::material::kTyre, 0.0f);
+  const glm::vec2 tyre(material::kTyre, 0.0f);
   auto ring = [&](float angle, float r, float y) {
     return c + glm::vec3(r * std::sin(angle), y, r * std::cos(angle));
   };
@@ -186,9 +186,9 @@ void add_wheel(render::MeshData& m, const glm::vec3& c, float radius, float widt
       // The rim: a spoke (its colour) or a gap (dark) in each of 2 * spokes wedges.
       const int wedge = (k * 2 * spokes) / count;
       const bool spoke = outer && wedge % 2 == 0;
-      const glm::vec2 uv(render::material::kTrim, spoke || (outer && k % 2 == 0 && spokes == 0)
-                                                      ? rim_colour
-                                                      : pack_trim_colour(0.02, 0.02, 0.02));
+      const glm::vec2 uv(material::kTrim, spoke || (outer && k % 2 == 0 && spokes == 0)
+                                              ? rim_colour
+                                              : pack_trim_colour(0.02, 0.02, 0.02));
       const float dish = outer ? -0.3f * half * side : 0.0f;  // the spokes dished in
       const std::uint32_t hub = m.add_vertex(c + glm::vec3(0.0f, y + dish, 0.0f), n, uv);
       const std::uint32_t r0 = m.add_vertex(ring(a0, rim, y), n, uv);

@@ -16,6 +16,7 @@
 #include <glm/vec3.hpp>
 
 #include "server/model/mesh_data.hpp"
+#include "server/sim/windshield.hpp"
 
 namespace downpour::model {
 
@@ -46,6 +47,17 @@ struct WindshieldOutline {
   double rake_deg = 0.0;
   double bow_mm = 0.0;
 };
+
+// The simulated glass an outline gives.
+inline sim::GlassConfig glass_of(const WindshieldOutline& w) {
+  sim::GlassConfig g;
+  g.bottom_width_mm = w.bottom_width_mm;
+  g.top_width_mm = w.top_width_mm;
+  g.height_mm = w.height_mm;
+  g.rake_deg = w.rake_deg;
+  g.bottom_left_m = w.bottom_left_m;
+  return g;
+}
 
 struct VehicleModel {
   render::MeshData mesh;

@@ -1,5 +1,7 @@
 #include "server/rpc/downpour_service.hpp"
 
+#include "server/rpc/models.hpp"
+
 #include <array>
 #include <cmath>
 #include <utility>
@@ -40,10 +42,12 @@ class StepReactor final : public grpc::ServerUnaryReactor {
 
 DownpourService::DownpourService(session::SessionRegistry& registry,
                                  session::FrameScheduler& scheduler, Limits limits,
-                                 Authenticator auth, std::shared_ptr<RoadNetworks> road_networks)
+                                 Authenticator auth, std::shared_ptr<RoadNetworks> road_networks,
+                                 std::shared_ptr<model::ModelLibrary> models)
     : scheduler_(scheduler),
       context_{registry, limits, std::move(auth),
-               road_networks ? std::move(road_networks) : std::make_shared<RoadNetworks>()},
+               road_networks ? std::move(road_networks) : std::make_shared<RoadNetworks>(),
+               models ? std::move(models) : std::make_shared<model::ModelLibrary>()},
       started_(std::chrono::steady_clock::now()) {}
 
 grpc::ServerUnaryReactor* DownpourService::CreateSession(grpc::CallbackServerContext* ctx,
@@ -62,6 +66,11 @@ grpc::ServerUnaryReactor* DownpourService::CreateSession(grpc::CallbackServerCon
   if (auto s = to_session_config(*request, context_.limits, &config, &initial); !s.ok())
     return finish(ctx, s);
   config.owner = who.name;
+  if (auto s = to_ego_models(*context_.models, request->ego(), "ego", &config); !s.ok())
+    return finish(ctx, s);
+  if (auto s = to_traffic_models(*context_.models, request->initial(), "initial", &initial);
+      !s.ok())
+    return finish(ctx, s);
   LoadedRoads roads;
   if (auto s = context_.road_networks->load(request->roads(), "roads", &roads); !s.ok())
     return finish(ctx, s);
@@ -128,6 +137,8 @@ grpc::ServerUnaryReactor* DownpourService::Update(grpc::CallbackServerContext* c
   sim::Update update;
   if (auto s = to_update(request->update(), "update", context_.limits, &update); !s.ok())
     return finish(ctx, s);
+  if (auto s = to_traffic_models(*context_.models, request->update(), "update", &update); !s.ok())
+    return finish(ctx, s);
   std::shared_ptr<Session> session;
   if (auto s = reach_session(context_.registry, request->session_id(), who, may_drive, &session);
       !s.ok())
@@ -150,6 +161,8 @@ grpc::ServerUnaryReactor* DownpourService::Step(grpc::CallbackServerContext* ctx
     return finish(ctx, s);
   sim::Update update;
   if (auto s = to_update(request->update(), "update", context_.limits, &update); !s.ok())
+    return finish(ctx, s);
+  if (auto s = to_traffic_models(*context_.models, request->update(), "update", &update); !s.ok())
     return finish(ctx, s);
   if (auto s = check_dt(request->dt_s(), "dt_s", false, context_.limits); !s.ok())
     return finish(ctx, s);

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "downpour/v1/downpour.grpc.pb.h"
+#include "server/model/model_library.hpp"
 #include "server/rpc/auth.hpp"
 #include "server/rpc/road_networks.hpp"
 #include "server/rpc/validation.hpp"
@@ -28,7 +29,8 @@ class DownpourService final : public ServiceBase {
  public:
   DownpourService(session::SessionRegistry& registry, session::FrameScheduler& scheduler,
                   Limits limits, Authenticator auth = {},
-                  std::shared_ptr<RoadNetworks> road_networks = nullptr);
+                  std::shared_ptr<RoadNetworks> road_networks = nullptr,
+                  std::shared_ptr<model::ModelLibrary> models = nullptr);
 
   grpc::ServerUnaryReactor* CreateSession(grpc::CallbackServerContext* ctx,
                                           const v1::CreateSessionRequest* request,
@@ -74,6 +76,7 @@ class DownpourService final : public ServiceBase {
     Limits limits;
     Authenticator auth;
     std::shared_ptr<RoadNetworks> road_networks;
+    std::shared_ptr<model::ModelLibrary> models;
     std::atomic<std::uint64_t> reader_drops{0};
     std::atomic<bool> draining{false};
     std::atomic<int> steps_in_flight{0};

@@ -1,5 +1,7 @@
 #include "server/rpc/drive_reactor.hpp"
 
+#include "server/rpc/models.hpp"
+
 #include <array>
 #include <cmath>
 #include <deque>
@@ -151,6 +153,8 @@ class DriveReactor final : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc
     session->touch();
     sim::Update update;
     if (auto s = to_update(req.update(), "update", ctx_.limits, &update); !s.ok()) return s;
+    if (auto s = to_traffic_models(*ctx_.models, req.update(), "update", &update); !s.ok())
+      return s;
     if (auto s = to_client_images(req.update(), "update", session->config().views, &update);
         !s.ok())
       return s;

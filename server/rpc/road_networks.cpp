@@ -8,6 +8,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "server/sim/file_name.hpp"
 #include "server/sim/opendrive_roads.hpp"
 
 namespace downpour::rpc {
@@ -26,13 +27,7 @@ RoadNetworks::RoadNetworks(std::string maps_dir, road::Limits limits)
     : maps_dir_(std::move(maps_dir)), limits_(limits) {}
 
 bool RoadNetworks::valid_map_name(const std::string& name) {
-  if (name.empty() || name.size() > kMaxMapName || name.front() == '.') return false;
-  for (const char c : name) {
-    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-                    c == '_' || c == '-' || c == '.';
-    if (!ok) return false;
-  }
-  return name.find("..") == std::string::npos;
+  return sim::plain_file_name(name, kMaxMapName);
 }
 
 std::shared_ptr<const sim::RoadNetwork> RoadNetworks::parse(const std::string& key,

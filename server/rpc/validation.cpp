@@ -8,6 +8,8 @@
 #include <sstream>
 
 #include "server/encode/image_decoder.hpp"
+#include "server/model/model_library.hpp"
+#include "server/sim/file_name.hpp"
 #include "server/sim/vehicle_class.hpp"
 
 namespace downpour::rpc {
@@ -240,6 +242,8 @@ grpc::Status to_update(const v1::Update& in, const std::string& field, const Lim
           return invalid(tf + ".vehicle_class",
                          "unknown class " + std::to_string(t.vehicle_class()));
       }
+      if (!t.model().empty() && !sim::plain_file_name(t.model()))
+        return invalid(tf + ".model", model::ModelLibrary::name_rule(t.model()));
       v.size_m = sim::vehicle_layout(v.vehicle_class).size_m;
       if (t.has_size_m()) {
         glm::dvec3 size;
@@ -436,8 +440,36 @@ grpc::Status to_client_images(const v1::Update& in, const std::string& field,
   return grpc::Status::OK;
 }
 
-grpc::Status to_ego(const v1::EgoVehicle& in, const std::string& field, sim::EgoGeometry* out) {
+grpc::Status check_glass(const sim::GlassConfig& g, const std::string& field) {
+  DP_RETURN_IF_ERROR(in_range(g.bottom_width_mm, 800.0, 2400.0, field + ".bottom_width_mm"));
+  DP_RETURN_IF_ERROR(in_range(g.top_width_mm, 500.0, g.bottom_width_mm, field + ".top_width_mm"));
+  DP_RETURN_IF_ERROR(in_range(g.height_mm, 300.0, 1500.0, field + ".height_mm"));
+  DP_RETURN_IF_ERROR(in_range(g.rake_deg, 0.0, 75.0, field + ".rake_deg"));
+  DP_RETURN_IF_ERROR(in_range(g.bottom_left_m.x, 0.5, 4.0, field + ".bottom_left_m.x"));
+  DP_RETURN_IF_ERROR(in_range(g.bottom_left_m.y, 0.0, 1.2, field + ".bottom_left_m.y"));
+  DP_RETURN_IF_ERROR(in_range(g.bottom_left_m.z, 0.5, 1.8, field + ".bottom_left_m.z"));
+  return grpc::Status::OK;
+}
+
+grpc::Status to_ego(const v1::EgoVehicle& in, const std::string& field, sim::EgoGeometry* out,
+                    sim::GlassConfig* glass) {
   sim::EgoGeometry ego;
+  for (const auto& [name, f] :
+       {std::pair{&in.body_model(), ".body_model"}, std::pair{&in.cabin_model(), ".cabin_model"}}) {
+    if (!name->empty() && !sim::plain_file_name(*name))
+      return invalid(field + f, model::ModelLibrary::name_rule(*name));
+  }
+  if (in.has_windshield()) {
+    const v1::Windshield& w = in.windshield();
+    sim::GlassConfig g;
+    g.bottom_width_mm = w.bottom_width_mm();
+    g.top_width_mm = w.top_width_mm();
+    g.height_mm = w.height_mm();
+    g.rake_deg = w.rake_deg();
+    g.bottom_left_m = {w.bottom_left_m().x(), w.bottom_left_m().y(), w.bottom_left_m().z()};
+    DP_RETURN_IF_ERROR(check_glass(g, field + ".windshield"));
+    *glass = g;
+  }
   auto given = [](const v1::Vec3& v) { return v.x() != 0.0 || v.y() != 0.0 || v.z() != 0.0; };
   if (given(in.size_m())) {
     DP_RETURN_IF_ERROR(in_range(in.size_m().x(), 2.0, 20.0, field + ".size_m.x"));
@@ -498,7 +530,7 @@ grpc::Status to_session_config(const v1::CreateSessionRequest& in, const Limits&
     DP_RETURN_IF_ERROR(in_range(in.fps(), 0.1, limits.max_fps, "fps"));
   c.fps = in.fps() > 0.0 ? in.fps() : 30.0;
   c.seed = in.seed();
-  DP_RETURN_IF_ERROR(to_ego(in.ego(), "ego", &c.ego));
+  DP_RETURN_IF_ERROR(to_ego(in.ego(), "ego", &c.ego, &c.glass));
   for (sim::ViewSpec& spec : c.views) spec.eye_m = c.ego.eye_m;
   DP_RETURN_IF_ERROR(to_update(in.initial(), "initial", limits, initial));
   DP_RETURN_IF_ERROR(to_client_images(in.initial(), "initial", c.views, initial));

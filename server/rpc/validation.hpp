@@ -11,6 +11,7 @@
 #include "downpour/v1/downpour.pb.h"
 #include "server/session/session.hpp"
 #include "server/sim/types.hpp"
+#include "server/sim/windshield.hpp"
 
 namespace downpour::rpc {
 
@@ -38,6 +39,8 @@ grpc::Status to_view_spec(const v1::ViewSpec& in, const std::string& field, cons
                           sim::ViewSpec* out);
 grpc::Status to_session_config(const v1::CreateSessionRequest& in, const Limits& limits,
                                session::SessionConfig* config, sim::Update* initial);
+// A windshield's figures within the ranges the contract gives (Windshield).
+grpc::Status check_glass(const sim::GlassConfig& g, const std::string& field);
 // dt_s in (0, max] for Step; [0, max] for Drive (0 = update only).
 grpc::Status check_dt(double dt_s, const std::string& field, bool allow_zero, const Limits& limits);
 grpc::Status check_session_id(const std::string& id, const std::string& field);

@@ -10,6 +10,7 @@ sim::SimulationConfig simulation_config(const SessionConfig& config) {
   sim::SimulationConfig c;
   c.roads = config.roads;
   c.ego = config.ego;
+  c.windshield.glass = config.glass;
   return c;
 }
 

@@ -18,6 +18,7 @@
 #include "server/session/tick_policy.hpp"
 #include "server/sim/simulation.hpp"
 #include "server/sim/types.hpp"
+#include "server/sim/windshield.hpp"
 
 namespace downpour::session {
 
@@ -31,6 +32,7 @@ struct SessionConfig {
   std::shared_ptr<const sim::RoadNetwork> roads;
   std::string road_network = "built-in track";
   sim::EgoGeometry ego;
+  sim::GlassConfig glass;  // the windshield the water runs on
 };
 
 struct StepOutcome {

@@ -14,7 +14,15 @@
 
 #include "server/sim/weather.hpp"
 
+// A vehicle's or cabin's model (model/vehicle_model.hpp): what the renderer draws. The simulation
+// carries it with the vehicle and never looks inside.
+namespace downpour::model {
+struct VehicleModel;
+}
+
 namespace downpour::sim {
+
+using ModelPtr = std::shared_ptr<const model::VehicleModel>;
 
 // Yaw / pitch / roll in degrees: yaw about world z (counter-clockwise from +x), then pitch about
 // the vehicle's y (nose down positive, as ISO 8855), then roll about its x.
@@ -58,6 +66,7 @@ struct TrafficVehicle {
   VehicleState state;
   glm::dvec3 size_m{4.5, 1.8, 1.5};
   VehicleClass vehicle_class = VehicleClass::kCar;
+  ModelPtr model;  // null: its class's built-in model
 };
 
 // The road's state under a point (road_water.hpp).
@@ -135,6 +144,8 @@ struct EgoGeometry {
   double wheelbase_m = 2.7;
   double track_m = 1.56;               // between the wheels' centres across
   glm::dvec3 eye_m{1.05, 0.37, 1.22};  // the driver's eye: the COCKPIT and RAIN views' camera
+  ModelPtr body_model;                 // null: the built-in car
+  ModelPtr cabin_model;                // null: the built-in cabin round the glass
 };
 
 enum class Background { kRendered, kClient };

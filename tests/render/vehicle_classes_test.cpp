@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 #include <glm/trigonometric.hpp>
 
+#include "server/model/default_models.hpp"
+#include "server/model/gltf_model.hpp"
 #include "server/render/cpu/camera.hpp"
 #include "server/sim/pose.hpp"
 #include "server/sim/vehicle_class.hpp"
@@ -148,6 +150,54 @@ TEST_F(VehicleClassesTest, EachModelsWheelsTurnAsItRolls) {
       EXPECT_LE(above, changed / 20) << static_cast<int>(c);
     }
   }
+}
+
+// A model from a glTF file draws as the built-in one it was written from: the traffic's truck and
+// the ego car's cabin, through write_glb and read_gltf, against the built-in path.
+TEST_F(VehicleClassesTest, AModelReadFromGltfDrawsAsTheBuiltInOne) {
+  sim::SceneState s = dry_scene();
+  const sim::Track& track = sim::Track::built_in();
+  const double s0 = track.project(glm::dvec2(s.vehicle.position_m), 50.0).s;
+  // 10 m ahead: near enough that the built-in truck is drawn in full, as a named model always is.
+  const sim::TrackFrame f = track.at(s0 + 10.0);
+  sim::TrafficVehicle v;
+  v.id = 2;
+  v.vehicle_class = sim::VehicleClass::kTruck;
+  v.size_m = sim::vehicle_layout(v.vehicle_class).size_m;
+  const glm::dvec2 xy = glm::dvec2(f.position) + f.left * track.lane_centre(0);
+  v.state.position_m = {xy.x, xy.y, track.surface_height(s0 + 10.0, track.lane_centre(0))};
+  v.state.rotation.yaw_deg = glm::degrees(f.heading_rad);
+  s.traffic = {v};
+  s.traffic_lights = {sim::VehicleLights{}};
+  const sim::ViewSpec spec = sim::view_spec(sim::View::kCockpit, kWidth, kHeight);
+  const RgbaImage built_in = render(spec, s);
+  auto read = model::read_gltf(model::write_glb(model::default_vehicle(v.vehicle_class)),
+                               model::ModelKind::kVehicle);
+  s.traffic[0].model = std::make_shared<const model::VehicleModel>(std::move(read));
+  s.traffic[0].size_m = glm::dvec3(s.traffic[0].model->size());
+  s.ego.cabin_model = std::make_shared<const model::VehicleModel>(
+      model::read_gltf(model::write_glb(model::default_cabin(s.glass)), model::ModelKind::kCabin));
+  const RgbaImage from_files = render(spec, s);
+  if (const char* dir = std::getenv("DOWNPOUR_TEST_IMAGES")) {
+    testing::write_png(std::string(dir) + "/model_built_in.png", built_in);
+    testing::write_png(std::string(dir) + "/model_from_gltf.png", from_files);
+  }
+  double sum = 0.0;
+  int worst = 0, off = 0;
+  for (std::size_t i = 0; i < built_in.pixels.size(); ++i) {
+    if (i % 4 == 3) continue;
+    const int d = std::abs(built_in.pixels[i] - from_files.pixels[i]);
+    sum += d;
+    worst = std::max(worst, d);
+    off += d > 8;
+  }
+  const double mean = sum / (0.75 * static_cast<double>(built_in.pixels.size()));
+  std::printf(
+      "from glTF against built in: mean difference %.3f levels, %d channels off by more "
+      "than 8 (largest %d)\n",
+      mean, off, worst);
+  EXPECT_LT(mean, 0.05);
+  EXPECT_LT(off, 10);
 }
 
 // The changed pixels' columns (x0, x1) and rows (y0, y1) of an image against another.

@@ -11,6 +11,8 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec4.hpp>
 
+#include "server/model/materials.hpp"
+
 namespace downpour::render {
 
 // Texture units: X(C++ name, unit, GLSL sampler type, GLSL name, what it holds).
@@ -96,25 +98,8 @@ namespace downpour::render {
     "column l: the lamp map's ring l, as road_water_rings: xy lower-left corner, z 1 / "      \
     "side, w cell (m)")
 
-// Material ids, carried in a mesh vertex's uv.x (model/default_models.cpp, model/gltf_model.cpp,
-// scene_geometry.cpp) and read by vehicle.frag and cockpit.frag: X(C++ name, id, GLSL constant,
-// what).
-#define DOWNPOUR_MATERIALS(X)                                             \
-  X(kBody, 0, MATERIAL_BODY, "paint, or the cabin's dashboard")           \
-  X(kGlass, 1, MATERIAL_GLASS, "windows")                                 \
-  X(kTyre, 2, MATERIAL_TYRE, "tyres")                                     \
-  X(kLamp, 3, MATERIAL_LAMP, "tail and brake lamps")                      \
-  X(kTrim, 4, MATERIAL_TRIM, "black trim, or the cabin's other plastics") \
-  X(kHeadlamp, 5, MATERIAL_HEADLAMP, "headlamps")                         \
-  X(kIndicatorLeft, 6, MATERIAL_INDICATOR_LEFT, "the left indicators")    \
-  X(kIndicatorRight, 7, MATERIAL_INDICATOR_RIGHT, "the right indicators") \
-  X(kStreetLamp, 8, MATERIAL_STREET_LAMP, "a street light's lens (street_light_pass.hpp)")
-
-namespace material {
-#define DOWNPOUR_MATERIAL_CONSTANT(name, id, glsl, what) inline constexpr float name = id;
-DOWNPOUR_MATERIALS(DOWNPOUR_MATERIAL_CONSTANT)
-#undef DOWNPOUR_MATERIAL_CONSTANT
-}  // namespace material
+// Material ids: model/materials.hpp (the models write them, the shaders read them).
+namespace material = model::material;
 
 // Shader storage buffers: X(C++ name, binding, GLSL macro, what it holds). A shader declares its
 // block at the macro: layout(std430, binding = RUNS_BUFFER).

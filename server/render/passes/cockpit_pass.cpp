@@ -17,6 +17,11 @@ void CockpitPass::execute(const FrameContext& frame, const FrameResources&) {
     interior_ = Mesh(model::default_cabin(built_for_).mesh);
   }
   program_.use();
+  named_.prune();
+  if (const sim::ModelPtr& cabin = frame.scene.ego.cabin_model) {
+    named_.get(cabin).draw(u_model_, frame.vehicle_to_world, 0.0, false);
+    return;
+  }
   u_model_.set(frame.vehicle_to_world);
   interior_.draw();
 }

@@ -1,11 +1,13 @@
 #pragma once
 
+#include "server/render/model_meshes.hpp"
 #include "server/render/pass.hpp"
 
 namespace downpour::render {
 
 // The cabin around the driver's eye: dashboard edge, A-pillars, roof liner and mirror, dark
-// silhouettes framing the view through the windshield, built around the glass of the scene.
+// silhouettes framing the view through the windshield, built around the glass of the scene; or
+// the cabin model the session names.
 class CockpitPass final : public Pass {
  public:
   explicit CockpitPass(SharedResources& shared);
@@ -20,7 +22,8 @@ class CockpitPass final : public Pass {
   ShaderProgram program_;
   Uniform u_model_;
   sim::GlassConfig built_for_;
-  Mesh interior_;
+  Mesh interior_;      // the built-in cabin round the glass
+  ModelMeshes named_;  // the cabin models sessions name
 };
 
 }  // namespace downpour::render

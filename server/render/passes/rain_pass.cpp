@@ -221,10 +221,11 @@ const std::vector<std::uint8_t>& RainPass::cabin_tiles_for(const FrameContext& f
                                                            int height) {
   const Camera& c = frame.camera;
   const sim::GlassConfig& g = frame.scene.glass;
+  const sim::ModelPtr& cabin = frame.scene.ego.cabin_model;
   for (const CabinTiles& t : cabin_tiles_) {
     if (t.width == width && t.height == height && t.eye == c.position_vehicle &&
         t.axes == c.axes_vehicle && t.tan_x == c.tan_half_fov_x && t.tan_y == c.tan_half_fov_y &&
-        model::same_cabin(t.glass, g))
+        t.cabin == cabin && (cabin || model::same_cabin(t.glass, g)))
       return t.hidden;
   }
   // Every driver's camera of the sessions at once, as a rule (a view's camera is fixed for its
@@ -232,9 +233,10 @@ const std::vector<std::uint8_t>& RainPass::cabin_tiles_for(const FrameContext& f
   // 3840x2160, once per camera; an entry is a byte per tile (32 KB at 3840x2160).
   constexpr std::size_t kKept = 64;
   if (cabin_tiles_.size() >= kKept) cabin_tiles_.erase(cabin_tiles_.begin());
-  cabin_tiles_.push_back(
-      {width, height, c.position_vehicle, c.axes_vehicle, c.tan_half_fov_x, c.tan_half_fov_y, g,
-       cabin_tiles(model::default_cabin(g).mesh, c, width, height, RainLayer::kTile)});
+  cabin_tiles_.push_back({width, height, c.position_vehicle, c.axes_vehicle, c.tan_half_fov_x,
+                          c.tan_half_fov_y, g, cabin,
+                          cabin_tiles(cabin ? cabin->mesh : model::default_cabin(g).mesh, c, width,
+                                      height, RainLayer::kTile)});
   return cabin_tiles_.back().hidden;
 }
 

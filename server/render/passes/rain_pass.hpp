@@ -77,7 +77,8 @@ class RainPass final : public Pass {
     glm::dvec3 eye{0.0};
     glm::dmat3 axes{1.0};
     double tan_x = 0.0, tan_y = 0.0;
-    sim::GlassConfig glass;  // the cabin is built around it
+    sim::GlassConfig glass;  // the built-in cabin is built around it
+    sim::ModelPtr cabin;     // or the session's cabin model
     std::vector<std::uint8_t> hidden;
   };
   const std::vector<std::uint8_t>& cabin_tiles_for(const FrameContext& frame, int width,

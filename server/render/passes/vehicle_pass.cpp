@@ -1,9 +1,6 @@
 #include "server/render/passes/vehicle_pass.hpp"
 
 #include <algorithm>
-#include <cmath>
-
-#include <glm/gtc/constants.hpp>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -27,23 +24,6 @@ VehiclePass::VehiclePass(SharedResources&)
   }
 }
 
-VehiclePass::Drawn::Drawn(const model::VehicleModel& m)
-    : mesh(m.mesh), fixed(m.fixed_index_count), bonnet(m.bonnet_index_count), wheels(m.wheels) {}
-
-void VehiclePass::draw(const Drawn& d, const glm::mat4& model, double rolled_m, bool bonnet_only) {
-  u_model_.set(model);
-  d.mesh.draw(0, bonnet_only ? d.bonnet : d.fixed);
-  if (bonnet_only) return;
-  for (const model::Wheel& w : d.wheels) {
-    const double turns = rolled_m / (2.0 * glm::pi<double>() * w.radius_m);
-    const auto angle = static_cast<float>(2.0 * glm::pi<double>() * (turns - std::floor(turns)));
-    u_model_.set(glm::translate(
-        glm::rotate(glm::translate(model, w.centre), angle, glm::vec3(0.0f, 1.0f, 0.0f)),
-        -w.centre));
-    d.mesh.draw(w.first_index, w.index_count);
-  }
-}
-
 void VehiclePass::prepare(const glm::vec3& colour, const sim::VehicleLights& lights,
                           bool flash_on) {
   u_body_colour_.set(colour);
@@ -63,13 +43,16 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
       frame.spec.view == sim::View::kCockpit || frame.spec.view == sim::View::kRain;
   const bool flash_on = sim::indicator_lit(frame.scene.sim_time_s);
   const sim::Weather& weather = frame.scene.weather;
-  // Seen from outside, at the session's size (the cabin keeps the default car's).
-  const glm::vec3 ego_scale =
-      cockpit ? glm::vec3(1.0f) : glm::vec3(frame.scene.ego.size_m / sim::EgoGeometry{}.size_m);
+  // Seen from outside, at the session's size (from the driver's seat, as the model was made).
+  named_.prune();
+  const sim::ModelPtr& ego_model = frame.scene.ego.body_model;
+  const glm::vec3 made = ego_model ? ego_model->size() : glm::vec3(sim::EgoGeometry{}.size_m);
+  const glm::vec3 ego_scale = cockpit ? glm::vec3(1.0f) : glm::vec3(frame.scene.ego.size_m) / made;
   prepare(glm::vec3(0.42f, 0.05f, 0.04f), shown_lights(frame.scene.ego_lights, weather), flash_on);
   const auto car = static_cast<std::size_t>(sim::VehicleClass::kCar);
-  draw(near_[car], glm::scale(frame.vehicle_to_world, ego_scale), frame.scene.ego_rolled_m,
-       cockpit);
+  (ego_model ? named_.get(ego_model) : near_[car])
+      .draw(u_model_, glm::scale(frame.vehicle_to_world, ego_scale), frame.scene.ego_rolled_m,
+            cockpit);
   // A vehicle under 40 pixels tall is drawn from its model for the distance.
   const float pixels_per_radian = 0.5f * static_cast<float>(frame.spec.height) /
                                   static_cast<float>(frame.camera.tan_half_fov_y);
@@ -81,8 +64,9 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
     const sim::TrafficVehicle& other = frame.scene.traffic[i];
     // The class's shape at its usual size, scaled to the reported one.
     const sim::VehicleLayout& layout = sim::vehicle_layout(other.vehicle_class);
-    const glm::mat4 model = glm::scale(glm::mat4(sim::vehicle_to_world(other.state)),
-                                       glm::vec3(sim::layout_scale(other)));
+    const glm::vec3 scale = other.model ? glm::vec3(other.size_m) / other.model->size()
+                                        : glm::vec3(sim::layout_scale(other));
+    const glm::mat4 model = glm::scale(glm::mat4(sim::vehicle_to_world(other.state)), scale);
     const glm::vec3 centre =
         glm::vec3(model * glm::vec4(glm::vec3(layout.rear_m + 0.5 * layout.size_m.x, 0.0,
                                               0.5 * layout.size_m.z),
@@ -99,7 +83,8 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
     const bool small =
         static_cast<float>(other.size_m.z) * pixels_per_radian < 40.0f * std::max(distance, 0.1f);
     const auto c = static_cast<std::size_t>(other.vehicle_class);
-    draw(small ? far_[c] : near_[c], model, rolled, false);
+    const ModelMesh& shape = other.model ? named_.get(other.model) : small ? far_[c] : near_[c];
+    shape.draw(u_model_, model, rolled, false);
   }
 }
 

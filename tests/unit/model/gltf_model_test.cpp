@@ -15,8 +15,8 @@
 
 #include "server/model/default_models.hpp"
 #include "server/model/gltf_model.hpp"
+#include "server/model/materials.hpp"
 #include "server/model/shapes.hpp"
-#include "server/render/cpu/shader_interface.hpp"
 
 namespace downpour::model {
 namespace {
@@ -134,7 +134,7 @@ TEST(GltfModelTest, OtherMaterialsAreTrimOfTheirOwnColour) {
   text.replace(text.find(R"({"name":"chrome"})"), 17,
                R"({"name":"chrome","pbrMetallicRoughness":{"baseColorFactor":[1,0.5,0,1]}})");
   const VehicleModel m = read_gltf(text, ModelKind::kVehicle);
-  EXPECT_EQ(m.mesh.vertices[0].uv.x, render::material::kTrim);
+  EXPECT_EQ(m.mesh.vertices[0].uv.x, material::kTrim);
   EXPECT_EQ(m.mesh.vertices[0].uv.y, pack_trim_colour(1.0, 0.5, 0.0));
 }
 
@@ -215,6 +215,21 @@ TEST(GltfModelTest, BrokenAndHostileFilesAreRefusedWithAReason) {
   }
 }
 
+TEST(GltfModelTest, TheBuiltInCabinComesBackWithItsGlass) {
+  sim::GlassConfig glass;
+  glass.rake_deg = 55.0;
+  glass.bottom_width_mm = 1450.0;
+  const VehicleModel built = default_cabin(glass);
+  const VehicleModel read = read_gltf(write_glb(built), ModelKind::kCabin);
+  EXPECT_EQ(read.triangles(), built.triangles());
+  EXPECT_LT(glm::length(read.mesh.bounds_min - built.mesh.bounds_min), 1e-4f);
+  ASSERT_TRUE(read.windshield.has_value());
+  const sim::GlassConfig back = glass_of(*read.windshield);
+  EXPECT_NEAR(back.bottom_width_mm, 1450.0, 0.5);
+  EXPECT_NEAR(back.rake_deg, 55.0, 0.02);
+  EXPECT_LT(glm::length(back.bottom_left_m - glass.bottom_left_m), 1e-3);
+}
+
 TEST(GltfModelTest, ACabinsWindshieldGivesTheGlasssOutline) {
   // The built-in cabin with the glass's own quad as its windshield, in glTF's axes.
   const sim::GlassConfig glass;
@@ -260,7 +275,7 @@ TEST(GltfModelTest, A200kTriangleModelReadsInUnderASecond) {
   // Rounded boxes finely cut until the model holds 200k triangles.
   for (int i = 0; big.triangles() < 200'000; ++i)
     add_rounded_box(big.mesh, {0.1f * i, -0.9f, 0.0f}, {0.1f * i + 4.0f, 0.9f, 1.4f}, 0.3f,
-                    {render::material::kBody}, {1, 1}, 24);
+                    {material::kBody}, {1, 1}, 24);
   big.fixed_index_count = static_cast<std::uint32_t>(big.mesh.indices.size());
   const std::string glb = write_glb(big);
   const auto t0 = std::chrono::steady_clock::now();
