@@ -88,7 +88,76 @@ def main():
     write("simulation", data)
     write("simulation", bytes([0]) + random_length_string(feed[0].SerializeToString()))
     images()
+    models()
     return 0
+
+
+def models():
+    """glTF seeds: a box car with a wheel node, as JSON with its buffer embedded and as binary
+    glTF; and a cabin's windshield quad. The first byte is the kind (0 vehicle, 1 cabin)."""
+    import base64
+    import json
+    import struct
+    shutil.rmtree(os.path.join(CORPUS, "gltf"), ignore_errors=True)
+
+    def box(w, h, z0, z1):
+        p = [(-w, 0, z0), (w, 0, z0), (w, h, z0), (-w, h, z0),
+             (-w, 0, z1), (w, 0, z1), (w, h, z1), (-w, h, z1)]
+        idx = [0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+               3, 7, 6, 3, 6, 2, 0, 4, 7, 0, 7, 3, 1, 2, 6, 1, 6, 5]
+        return b"".join(struct.pack("<3f", *v) for v in p) + struct.pack("<36H", *idx)
+
+    body = box(0.9, 1.4, -1.0, 3.6)
+    wheel = box(0.1, 0.6, -0.3, 0.3)
+    blob = body + wheel
+
+    def document(uri):
+        return {
+            "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+            "nodes": [{"name": "body", "mesh": 0},
+                      {"name": "wheel_rl", "mesh": 1, "translation": [0.8, 0, 0],
+                       "children": []}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1,
+                                        "material": 0}]},
+                       {"primitives": [{"attributes": {"POSITION": 2}, "indices": 3,
+                                        "material": 1}]}],
+            "materials": [{"name": "Paint"}, {"name": "tyre"},
+                          {"name": "chrome", "pbrMetallicRoughness":
+                           {"baseColorFactor": [0.6, 0.6, 0.6, 1]}}],
+            "accessors": [
+                {"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3"},
+                {"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"},
+                {"bufferView": 2, "componentType": 5126, "count": 8, "type": "VEC3"},
+                {"bufferView": 3, "componentType": 5123, "count": 36, "type": "SCALAR"}],
+            "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 96},
+                            {"buffer": 0, "byteOffset": 96, "byteLength": 72},
+                            {"buffer": 0, "byteOffset": 168, "byteLength": 96},
+                            {"buffer": 0, "byteOffset": 264, "byteLength": 72}],
+            "buffers": [{"byteLength": len(blob), **({"uri": uri} if uri else {})}]}
+
+    text = json.dumps(document("data:application/octet-stream;base64," +
+                               base64.b64encode(blob).decode())).encode()
+    write("gltf", bytes([0]) + text)
+    chunk = json.dumps(document(None)).encode()
+    chunk += b" " * (-len(chunk) % 4)
+    glb = (struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(chunk) + 8 + len(blob)) +
+           struct.pack("<I4s", len(chunk), b"JSON") + chunk +
+           struct.pack("<I4s", len(blob), b"BIN\0") + blob)
+    write("gltf", bytes([0]) + glb)
+    quad = struct.pack("<12f", 0.76, 0.98, 2.06, -0.76, 0.98, 2.06, -0.68, 1.36, 1.40,
+                       0.68, 1.36, 1.40) + struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+    cabin = {"asset": {"version": "2.0"}, "nodes": [{"mesh": 0}],
+             "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1,
+                                         "material": 0}]}],
+             "materials": [{"name": "windshield"}],
+             "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"},
+                           {"bufferView": 1, "componentType": 5123, "count": 6,
+                            "type": "SCALAR"}],
+             "bufferViews": [{"buffer": 0, "byteLength": 48},
+                             {"buffer": 0, "byteOffset": 48, "byteLength": 12}],
+             "buffers": [{"byteLength": 60, "uri": "data:application/octet-stream;base64," +
+                          base64.b64encode(quad).decode()}]}
+    write("gltf", bytes([1]) + json.dumps(cabin).encode())
 
 
 def images():

@@ -9,7 +9,7 @@ import pathlib
 import re
 import sys
 
-ORDER = ["app", "rpc", "session", "render", "sim", "road", "encode"]
+ORDER = ["app", "rpc", "session", "render", "model", "sim", "road", "encode"]
 # What each room of render/ may include of render/.
 ROOMS = {"render/gl": {"render/gl", "render/cpu"}, "render/cpu": {"render/cpu"}}
 GL_HEADERS = re.compile(r"#include\s*[<\"](GL/|EGL/|epoxy/|server/render/gl/gl\.hpp)")

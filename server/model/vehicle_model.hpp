@@ -68,7 +68,9 @@ struct VehicleModel {
   std::optional<WindshieldOutline> windshield;
 
   std::size_t triangles() const { return mesh.indices.size() / 3; }
-  glm::vec3 size() const { return mesh.bounds_max - mesh.bounds_min; }
+  glm::vec3 size() const {
+    return mesh.vertices.empty() ? glm::vec3(0.0f) : mesh.bounds_max - mesh.bounds_min;
+  }
 };
 
 }  // namespace downpour::model
