@@ -19,7 +19,8 @@ constexpr float kSmoothedFromPx = 2.0f;  // a body's sphere of a smaller radius 
 // A parcel stands for a cloud of droplets, not a ball of white: its optical depth is capped, so
 // that a dense cloud is dense by the parcels that overlap in it.
 constexpr float kMaxCloudDepth = 1.5f;
-constexpr float kHazeVisible = 0.004f;  // optical depth below which the haze is not composited
+constexpr float kHazeVisible = 0.004f;
+constexpr float kCloudSpread = 1.8f;  // optical depth below which the haze is not composited
 
 // Marks the tiles a screen circle (pixels) touches.
 void mark(std::vector<std::uint8_t>& tiles, int tiles_x, int tiles_y, glm::vec2 centre,
@@ -185,10 +186,11 @@ void SprayPass::cull(const FrameContext& frame, int width, int height, int tiles
       if (mark_all) mark(liquid_tiles_, tiles_x, tiles_y, centre, cover);
       if (body) mark(body_tiles_, tiles_x, tiles_y, centre, cover + kPlaneRadius);
     }
-    // The cloud: drawn at least a haze pixel wide, its optical depth thinned to keep its
-    // extinction. Parcels at the camera are too few to stand for the cloud around it: they fade
-    // in from 0.5 to 3 m.
-    const float r = std::max(p.radius_m, kHazeScale * pixel_m);
+    // The cloud: spread over kCloudSpread times the parcel's radius (a parcel stands for a cloud
+    // that merges with its neighbours', not a puff of its own), at least a haze pixel wide, its
+    // optical depth thinned to keep its extinction. Parcels at the camera are too few to stand for
+    // the cloud around it: they fade in from 0.5 to 3 m.
+    const float r = std::max(kCloudSpread * p.radius_m, kHazeScale * pixel_m);
     const float near = std::clamp((z - 0.5f) / 2.5f, 0.0f, 1.0f);
     const float depth =
         p.haze_depth * (p.radius_m / r) * (p.radius_m / r) * near * near * (3.0f - 2.0f * near);
