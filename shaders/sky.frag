@@ -9,11 +9,10 @@ void main() {
   // A cloud deck at about 1.5 km, drifting with the wind; it thickens and greys with overcast.
   if (dir.z > 0.0) {
     vec2 p = frame.camera_pos.xy + dir.xy * (1500.0 / (dir.z + 0.08)) + frame.wind.xy * frame.time_s * 3.0;
-    // Three octaves of value noise, each turned from the last, so that no lattice's squares show.
-    const mat2 turn1 = mat2(0.80, 0.60, -0.60, 0.80), turn2 = mat2(0.28, 0.96, -0.96, 0.28);
-    float n = texture(noise_tex, p / 9000.0).r * 0.5 + texture(noise_tex, turn1 * p / 2300.0).g * 0.32 +
-              texture(noise_tex, turn2 * p / 800.0).b * 0.18;
-    n = 0.5 + (n - 0.5) * 1.17;  // (the spread of the two octaves before: the same cover)
+    // Two octaves of value noise, the finer turned against the coarser, so that no lattice's
+    // squares show.
+    const mat2 turn = mat2(0.80, 0.60, -0.60, 0.80);
+    float n = texture(noise_tex, p / 9000.0).r * 0.6 + texture(noise_tex, turn * p / 1900.0).b * 0.4;
     float overcast = frame.overcast;
     float cover = smoothstep(0.75 - overcast * 0.8, 1.05 - overcast * 0.6, n);
     vec3 cloud_lit = mix(frame.sky_horizon.rgb * 1.15, frame.sky_horizon.rgb * 0.7, overcast * n) *

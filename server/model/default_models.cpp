@@ -38,14 +38,22 @@ struct Builder {
   // A rounded box among the fixed parts, its edges cut as finely as the detail asks.
   void box(const glm::vec3& lo, const glm::vec3& hi, float radius, Look look,
            glm::vec2 taper = glm::vec2(1.0f), int segments = 2) {
-    add_rounded_box(fixed, lo, hi, radius, look, taper, detail == Detail::kFar ? 1 : segments);
+    // For the distance, a plain box: its edges' rounding is under a pixel there.
+    if (detail == Detail::kFar)
+      add_rounded_box(fixed, lo, hi, 0.0f, look, taper, 0);
+    else
+      add_rounded_box(fixed, lo, hi, radius, look, taper, segments);
   }
 
   void wheel(const glm::vec3& centre, float radius, float width, int spokes, float rim) {
-    render::MeshData w;
     const float outward = std::abs(centre.y) < 0.05f ? 0.0f : centre.y > 0.0f ? 1.0f : -1.0f;
-    add_wheel(w, centre, radius, width, outward, detail == Detail::kFar ? 0 : spokes, rim,
-              detail == Detail::kFar ? 10 : 18);
+    // For the distance, wheels that do not turn, among the fixed parts: one draw a vehicle.
+    if (detail == Detail::kFar) {
+      add_wheel(fixed, centre, radius, width, outward, 0, rim, 8);
+      return;
+    }
+    render::MeshData w;
+    add_wheel(w, centre, radius, width, outward, spokes, rim, 18);
     Wheel entry;
     entry.centre = centre;
     entry.radius_m = radius;
@@ -203,14 +211,14 @@ VehicleModel car(Detail detail) {
 
 // A wide vehicle's lamps at its front and back (sim::VehicleLayout's places): a headlamp with an
 // indicator outboard, a tail lamp with an indicator under it, each side.
-void add_box_lamps(render::MeshData& m, const sim::VehicleLayout& l, float front) {
+void add_box_lamps(Builder& b, const sim::VehicleLayout& l, float front) {
   const auto hy = static_cast<float>(l.headlamp_m.y), hz = static_cast<float>(l.headlamp_m.z);
   const auto ty = static_cast<float>(l.tail_lamp_m.y), tz = static_cast<float>(l.tail_lamp_m.z);
   const auto rear = static_cast<float>(l.rear_m);
   for (float s : {1.0f, -1.0f}) {
     auto span = [s](float a, float b) { return s > 0 ? glm::vec2(a, b) : glm::vec2(-b, -a); };
     auto lamp = [&](float x0, float x1, glm::vec2 y, float z0, float z1, Look look) {
-      add_rounded_box(m, {x0, y.x, z0}, {x1, y.y, z1}, 0.015f, look, {1, 1}, 1);
+      b.box({x0, y.x, z0}, {x1, y.y, z1}, 0.015f, look, {1, 1}, 1);
     };
     lamp(front - 0.04f, front + 0.025f, span(hy - 0.15f, hy + 0.15f), hz - 0.08f, hz + 0.08f,
          kHeadlampLook);
@@ -246,7 +254,7 @@ VehicleModel truck(Detail detail) {
   for (float x : {0.0f, 7.5f})
     b.box({x - (x > 0 ? 0.6f : 1.3f), -1.28f, 1.0f},
           {x + 0.6f + (x > 0 ? 0.0f : 0.1f), 1.28f, 1.12f}, 0.03f, kTrim, {1, 1}, 1);
-  add_box_lamps(b.fixed, l, front);
+  add_box_lamps(b, l, front);
   for (float x : {-0.65f, 0.65f, 7.5f})
     for (float y : {-1.0f, 1.0f}) b.wheel({x, y * 1.0f, 0.5f}, 0.5f, 0.4f, 8, kSilver);
   return std::move(b).finish();
@@ -274,7 +282,7 @@ VehicleModel bus(Detail detail) {
   b.box({rear - 0.01f, -half + 0.02f, 1.15f}, {rear + 0.8f, half - 0.02f, 2.7f}, 0.06f, kPaint);
   for (float x = rear + 2.0f; x < front - 1.0f; x += 1.6f)
     b.box({x, -half - 0.005f, 1.15f}, {x + 0.12f, half + 0.005f, 2.7f}, 0.02f, kTrim, {1, 1}, 1);
-  add_box_lamps(b.fixed, l, front);
+  add_box_lamps(b, l, front);
   for (float x : axles)
     for (float y : {-1.0f, 1.0f}) b.wheel({x, y * 1.02f, 0.5f}, 0.5f, 0.32f, 8, kSilver);
   return std::move(b).finish();
@@ -323,8 +331,6 @@ VehicleModel default_cabin(const sim::GlassConfig& glass) {
   m.add_face({dash_back, 0.85f, 0.55f}, {dash_back, -0.85f, 0.55f},
              {dash_back, -0.85f, dash_top - 0.03f}, {dash_back, 0.85f, dash_top - 0.03f},
              material::kTrim);
-  add_rounded_box(m, {dash_back - 0.005f, -0.86f, dash_top - 0.06f},
-                  {dash_back + 0.06f, 0.86f, dash_top + 0.004f}, 0.03f, kTrim, {1, 1}, 1);
   // The instrument hood in front of the driver, rounded.
   add_rounded_box(m, {dash_back - 0.03f, 0.17f, 0.88f}, {1.78f, 0.57f, 1.03f}, 0.05f, kTrim,
                   {0.9f, 0.92f}, 1);

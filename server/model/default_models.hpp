@@ -12,7 +12,8 @@
 namespace downpour::model {
 
 // How finely a model is cut: in full, or for the distance (a few thousand triangles against a few
-// hundred: the renderer draws vehicles far away, small in the picture, in the second).
+// hundred, plain boxes, and wheels that do not turn, drawn with the rest at once: the renderer
+// draws vehicles far away, small in the picture, in the second).
 enum class Detail { kFull, kFar };
 VehicleModel default_vehicle(sim::VehicleClass c, Detail detail = Detail::kFull);
 // Dashboard, instrument hood, A-pillars along the glass's side edges, roof liner and rear-view

@@ -146,7 +146,9 @@ void add_loft(render::MeshData& m, const std::vector<Section>& sections, int aro
 void add_wheel(render::MeshData& m, const glm::vec3& c, float radius, float width, float outward,
                int spokes, float rim_colour, int around) {
   const int count = around;
-  const float half = 0.5f * width, rim = 0.64f * radius, shoulder = 0.04f * radius / 0.33f;
+  // (Cut coarsely, a wheel for the distance: its tread one band, no shoulders.)
+  const float half = 0.5f * width, rim = 0.64f * radius,
+              shoulder = around < 12 ? 0.0f : 0.04f * radius / 0.33f;
   const glm::vec2 tyre(material::kTyre, 0.0f);
   auto ring = [&](float angle, float r, float y) {
     return c + glm::vec3(r * std::sin(angle), y, r * std::cos(angle));
@@ -157,7 +159,7 @@ void add_wheel(render::MeshData& m, const glm::vec3& c, float radius, float widt
     // The tread, and the shoulders rounding into the walls.
     const float ys[4] = {-half, -half + shoulder, half - shoulder, half};
     const float rs[4] = {radius - shoulder, radius, radius, radius - shoulder};
-    for (int s = 0; s < 3; ++s) {
+    for (int s = shoulder > 0.0f ? 0 : 1; s < (shoulder > 0.0f ? 3 : 2); ++s) {
       const glm::vec3 tilt0(0.0f, s == 0 ? -0.7f : s == 2 ? 0.7f : 0.0f, 0.0f);
       const std::uint32_t a =
           m.add_vertex(ring(a0, rs[s], ys[s]), glm::normalize(n0 + tilt0), tyre);
