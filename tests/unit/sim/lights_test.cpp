@@ -126,5 +126,24 @@ TEST(LightsTest, StreetLightsStandBesideTheRoadAtTheirSpacingAndLightAtDusk) {
   EXPECT_TRUE(street_lights_on(w)) << "a dark overcast afternoon";
 }
 
+// How far a vehicle has rolled, for its wheels: its forward speed over the updates (the mean of
+// each two), on at the last speed between them; backwards counts back.
+TEST(VehicleMotionTest, RolledDistanceFollowsTheForwardSpeed) {
+  VehicleMotion m;
+  VehicleState s;
+  s.rotation.yaw_deg = 90.0;  // heading +y
+  s.velocity_mps = {0.0, 10.0, 0.0};
+  m.observe(s, 1.0);
+  EXPECT_DOUBLE_EQ(m.rolled_at(1.0), 0.0);
+  EXPECT_NEAR(m.rolled_at(1.5), 5.0, 1e-9);
+  s.velocity_mps = {0.0, 20.0, 0.0};
+  m.observe(s, 2.0);
+  EXPECT_NEAR(m.rolled_at(2.0), 15.0, 1e-9);  // the mean of 10 and 20 over a second
+  s.velocity_mps = {0.0, -4.0, 0.0};          // reversing
+  m.observe(s, 3.0);
+  EXPECT_NEAR(m.rolled_at(3.0), 23.0, 1e-9);
+  EXPECT_NEAR(m.rolled_at(4.0), 19.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace downpour::sim
