@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <new>
 #include <sstream>
 #include <system_error>
 #include <utility>
@@ -164,8 +165,8 @@ class Accessors {
       throw ModelError(std::string(what) + " must be floats of " +
                        std::to_string(tinygltf::GetNumComponentsInType(type)) + " components");
     const int n = tinygltf::GetNumComponentsInType(type);
+    const auto [data, stride] = locate(a, 4 * n, what);  // (its count checked before it is used)
     std::vector<float> out(a.count * n);
-    const auto [data, stride] = locate(a, 4 * n, what);
     for (std::size_t i = 0; i < a.count; ++i) std::memcpy(&out[i * n], data + i * stride, 4 * n);
     for (float v : out)
       if (!std::isfinite(v)) throw ModelError(std::string(what) + " holds a number not finite");
@@ -540,18 +541,26 @@ VehicleModel read_gltf(std::string_view bytes, ModelKind kind, const ModelLimits
   tinygltf::Model m;
   std::string err, warn;
   const std::string base = beside.empty() ? std::string() : beside.string();
-  const bool ok =
-      binary ? loader.LoadBinaryFromMemory(&m, &err, &warn,
-                                           reinterpret_cast<const unsigned char*>(bytes.data()),
-                                           static_cast<unsigned>(bytes.size()), base)
-             : loader.LoadASCIIFromString(&m, &err, &warn, bytes.data(),
-                                          static_cast<unsigned>(bytes.size()), base);
+  bool ok = false;
+  try {  // (the parser's own exceptions, and memory that cannot be had, are a refusal too)
+    ok = binary ? loader.LoadBinaryFromMemory(&m, &err, &warn,
+                                              reinterpret_cast<const unsigned char*>(bytes.data()),
+                                              static_cast<unsigned>(bytes.size()), base)
+                : loader.LoadASCIIFromString(&m, &err, &warn, bytes.data(),
+                                             static_cast<unsigned>(bytes.size()), base);
+  } catch (const std::exception& e) {
+    err = e.what();
+  }
   if (!ok) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     if (err.size() > 300) err = err.substr(0, 300) + "...";
     throw ModelError("not a glTF 2.0 model: " + (err.empty() ? std::string("unreadable") : err));
   }
-  return assemble(Reader(m, kind, limits).gather(), kind);
+  try {
+    return assemble(Reader(m, kind, limits).gather(), kind);
+  } catch (const std::bad_alloc&) {
+    throw ModelError("the model is too large to hold");
+  }
 }
 
 VehicleModel read_gltf_file(const std::filesystem::path& path, ModelKind kind,
