@@ -361,13 +361,7 @@ VehicleModel default_cabin(const sim::GlassConfig& glass) {
   out.mesh = std::move(m);
   out.fixed_index_count = static_cast<std::uint32_t>(out.mesh.indices.size());
   out.bonnet_index_count = out.fixed_index_count;
-  WindshieldOutline w;
-  w.bottom_left_m = glass.bottom_left_m;
-  w.bottom_width_mm = glass.bottom_width_mm;
-  w.top_width_mm = glass.top_width_mm;
-  w.height_mm = glass.height_mm;
-  w.rake_deg = glass.rake_deg;
-  out.windshield = w;
+  out.windshield = outline_of(glass);
   return out;
 }
 

@@ -603,12 +603,6 @@ const char* material_name(float id) {
   }
 }
 
-std::array<double, 3> unpack_trim_colour(float code) {
-  const int c = static_cast<int>(code + 0.5f) - 1;
-  if (c < 0) return {1.0, 1.0, 1.0};  // glTF's default: the reader's built-in trim
-  return {(c >> 10 & 31) / 31.0, (c >> 5 & 31) / 31.0, (c & 31) / 31.0};
-}
-
 struct Writer {
   tinygltf::Model g;
   std::vector<unsigned char>& bin;

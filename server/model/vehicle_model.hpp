@@ -6,6 +6,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -27,6 +28,13 @@ inline float pack_trim_colour(double r, double g, double b) {
     return static_cast<int>(std::lround(std::clamp(c, 0.0, 1.0) * 31.0));
   };
   return static_cast<float>(1 + (five(r) << 10 | five(g) << 5 | five(b)));
+}
+
+// Its inverse (1 + the code): linear red, green and blue; none, glTF's default white.
+inline std::array<double, 3> unpack_trim_colour(float code) {
+  const int c = static_cast<int>(code + 0.5f) - 1;
+  if (c < 0) return {1.0, 1.0, 1.0};
+  return {(c >> 10 & 31) / 31.0, (c >> 5 & 31) / 31.0, (c & 31) / 31.0};
 }
 
 struct Wheel {
@@ -57,6 +65,17 @@ inline sim::GlassConfig glass_of(const WindshieldOutline& w) {
   g.rake_deg = w.rake_deg;
   g.bottom_left_m = w.bottom_left_m;
   return g;
+}
+
+// And the outline a glass gives (flat).
+inline WindshieldOutline outline_of(const sim::GlassConfig& g) {
+  WindshieldOutline w;
+  w.bottom_left_m = g.bottom_left_m;
+  w.bottom_width_mm = g.bottom_width_mm;
+  w.top_width_mm = g.top_width_mm;
+  w.height_mm = g.height_mm;
+  w.rake_deg = g.rake_deg;
+  return w;
 }
 
 struct VehicleModel {

@@ -60,8 +60,8 @@ grpc::Status to_ego_models(model::ModelLibrary& library, const v1::EgoVehicle& i
   if (!in.has_windshield()) {
     config->glass = model::glass_of(*outline);
     if (auto s = check_glass(config->glass, f + " (its windshield)"); !s.ok()) return s;
-    if (outline->bow_mm <= 25.0) return grpc::Status::OK;
   }
+  // (Against its own glass, only a bow out of flat can disagree.)
   if (const auto why = model::glass_disagreement(*outline, config->glass))
     return {grpc::StatusCode::INVALID_ARGUMENT,
             f + ": " + *why + (in.has_windshield() ? " (" + field + ".windshield)" : "")};
