@@ -53,7 +53,10 @@ void add_rounded_box(render::MeshData& m, const glm::vec3& lo, const glm::vec3& 
           p[b] = vb;
           const glm::vec3 q = glm::clamp(p, -core, core);
           const glm::vec3 d = p - q;
-          const glm::vec3 n = glm::length(d) > 0.0f ? glm::normalize(d) : glm::vec3(0.0f);
+          // (A plain box, radius 0, has no rounding to take a normal from: its face's.)
+          glm::vec3 face(0.0f);
+          face[axis] = side;
+          const glm::vec3 n = glm::length(d) > 0.0f ? glm::normalize(d) : face;
           glm::vec3 out = q + r * n;
           const float up = (out.z + half.z) / (2.0f * half.z);  // 0 at the bottom, 1 at the top
           out.x *= 1.0f + (taper.x - 1.0f) * up;
