@@ -1,5 +1,9 @@
 #include "server/render/chunked_mesh.hpp"
 
+#include <algorithm>
+#include <cstdint>
+#include <stdexcept>
+
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
@@ -7,32 +11,72 @@
 
 namespace downpour::render {
 
+namespace {
+
+// Appends `part` to `all`, its indices moved past the vertices already there.
+void append(MeshData& all, const MeshData& part) {
+  const bool first = all.vertices.empty();
+  if (!first && (all.curvature.empty() != part.curvature.empty() ||
+                 all.lanes.empty() != part.lanes.empty())) {
+    throw std::logic_error("a chunked mesh's parts differ in their attributes");
+  }
+  const auto base = static_cast<std::uint32_t>(all.vertices.size());
+  all.vertices.insert(all.vertices.end(), part.vertices.begin(), part.vertices.end());
+  all.curvature.insert(all.curvature.end(), part.curvature.begin(), part.curvature.end());
+  all.lanes.insert(all.lanes.end(), part.lanes.begin(), part.lanes.end());
+  all.indices.reserve(all.indices.size() + part.indices.size());
+  for (const std::uint32_t i : part.indices) all.indices.push_back(base + i);
+  all.bounds_min = glm::min(all.bounds_min, part.bounds_min);
+  all.bounds_max = glm::max(all.bounds_max, part.bounds_max);
+}
+
+}  // namespace
+
 ChunkedMesh::ChunkedMesh(const std::vector<std::vector<MeshData>>& chunks,
                          std::vector<float> level_distances_m, float max_distance_m)
     : level_distances_m_(std::move(level_distances_m)), max_distance_m_(max_distance_m) {
-  chunks_.reserve(chunks.size());
-  for (const std::vector<MeshData>& levels : chunks) {
-    Chunk c;
-    c.bounds_min = glm::vec3(1e30f);
-    c.bounds_max = glm::vec3(-1e30f);
-    for (const MeshData& level : levels) {
-      c.levels.emplace_back(level);
-      c.bounds_min = glm::min(c.bounds_min, level.bounds_min);
-      c.bounds_max = glm::max(c.bounds_max, level.bounds_max);
-    }
-    chunks_.push_back(std::move(c));
+  // Level by level, each level's chunks in their order: neighbours drawn at one level are one
+  // range of indices, and draw_visible() joins them into one draw.
+  std::size_t levels = 0;
+  chunks_.resize(chunks.size());
+  for (std::size_t c = 0; c < chunks.size(); ++c) {
+    levels = std::max(levels, chunks[c].size());
+    chunks_[c].levels.resize(chunks[c].size());
+    chunks_[c].bounds_min = glm::vec3(1e30f);
+    chunks_[c].bounds_max = glm::vec3(-1e30f);
   }
+  MeshData all;
+  for (std::size_t l = 0; l < levels; ++l) {
+    for (std::size_t c = 0; c < chunks.size(); ++c) {
+      if (l >= chunks[c].size()) continue;
+      const MeshData& level = chunks[c][l];
+      Chunk& chunk = chunks_[c];
+      chunk.levels[l] = {static_cast<std::uint32_t>(all.indices.size()),
+                         static_cast<std::uint32_t>(level.indices.size())};
+      append(all, level);
+      chunk.bounds_min = glm::min(chunk.bounds_min, level.bounds_min);
+      chunk.bounds_max = glm::max(chunk.bounds_max, level.bounds_max);
+    }
+  }
+  if (!all.indices.empty()) mesh_ = Mesh(all);
+  ranges_.reserve(chunks_.size());
+  counts_.reserve(chunks_.size());
+  offsets_.reserve(chunks_.size());
 }
 
 template <typename Fn>
 void ChunkedMesh::for_each_visible(const glm::mat4& view_proj, const glm::vec3& camera,
-                                   float distance_scale, Fn&& fn) const {
+                                   float distance_scale, float from_m, float to_m, Fn&& fn) const {
   for (const Chunk& chunk : chunks_) {
     if (chunk.levels.empty() || !box_visible(view_proj, chunk.bounds_min, chunk.bounds_max))
       continue;
-    const float distance =
-        glm::length(glm::clamp(camera, chunk.bounds_min, chunk.bounds_max) - camera) *
-        distance_scale;
+    const float nearest =
+        glm::length(glm::clamp(camera, chunk.bounds_min, chunk.bounds_max) - camera);
+    if (nearest >= to_m) continue;
+    if (from_m > 0.0f && glm::length(glm::max(glm::abs(camera - chunk.bounds_min),
+                                              glm::abs(camera - chunk.bounds_max))) < from_m)
+      continue;
+    const float distance = nearest * distance_scale;
     if (distance >= max_distance_m_) continue;
     std::size_t level = 0;
     while (level < level_distances_m_.size() && level + 1 < chunk.levels.size() &&
@@ -44,15 +88,35 @@ void ChunkedMesh::for_each_visible(const glm::mat4& view_proj, const glm::vec3& 
 }
 
 void ChunkedMesh::draw_visible(const glm::mat4& view_proj, const glm::vec3& camera,
-                               float distance_scale) const {
-  for_each_visible(view_proj, camera, distance_scale, [](const Mesh& mesh) { mesh.draw(); });
+                               float distance_scale, float from_m, float to_m) const {
+  ranges_.clear();
+  for_each_visible(view_proj, camera, distance_scale, from_m, to_m, [this](const Range& r) {
+    if (r.count != 0) ranges_.push_back(r);
+  });
+  // Ranges that meet in the buffer become one.
+  std::sort(ranges_.begin(), ranges_.end(),
+            [](const Range& a, const Range& b) { return a.first_index < b.first_index; });
+  counts_.clear();
+  offsets_.clear();
+  std::uint32_t end = 0;
+  for (const Range& r : ranges_) {
+    if (!counts_.empty() && r.first_index == end) {
+      counts_.back() += static_cast<GLsizei>(r.count);
+    } else {
+      counts_.push_back(static_cast<GLsizei>(r.count));
+      offsets_.push_back(
+          reinterpret_cast<const void*>(static_cast<std::uintptr_t>(r.first_index) * 4u));
+    }
+    end = r.first_index + r.count;
+  }
+  mesh_.multi_draw(counts_.data(), offsets_.data(), static_cast<GLsizei>(counts_.size()));
 }
 
 std::size_t ChunkedMesh::visible_triangles(const glm::mat4& view_proj,
                                            const glm::vec3& camera) const {
   std::size_t triangles = 0;
-  for_each_visible(view_proj, camera, 1.0f,
-                   [&](const Mesh& mesh) { triangles += mesh.triangles(); });
+  for_each_visible(view_proj, camera, 1.0f, 0.0f, 1e30f,
+                   [&](const Range& r) { triangles += r.count / 3; });
   return triangles;
 }
 

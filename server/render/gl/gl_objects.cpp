@@ -157,6 +157,12 @@ void Mesh::draw(std::uint32_t first_index, std::uint32_t count) const {
                  reinterpret_cast<const void*>(static_cast<std::uintptr_t>(first_index) * 4u));
 }
 
+void Mesh::multi_draw(const GLsizei* counts, const void* const* offsets, GLsizei draws) const {
+  if (draws == 0 || index_count_ == 0) return;
+  glBindVertexArray(vao_.id());
+  glMultiDrawElements(GL_TRIANGLES, counts, GL_UNSIGNED_INT, offsets, draws);
+}
+
 FullscreenTriangle::FullscreenTriangle() {
   GLuint vao = 0;
   glCreateVertexArrays(1, &vao);

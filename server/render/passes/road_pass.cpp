@@ -96,12 +96,14 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
     programs_[plain + 3].use();
     mean_lit_[plain + 3].set(mean_lit);
     near_split_[plain + 3].set(glm::vec2(reach, 1.0f));
-    frame.world->road.draw_visible(view_proj, frame.camera.position);
+    // (Only the chunks that reach into the near part, and then those that reach beyond it.)
+    frame.world->road.draw_visible(view_proj, frame.camera.position, 1.0f, 0.0f, reach);
   }
   programs_[plain].use();
   mean_lit_[plain].set(mean_lit);
   near_split_[plain].set(glm::vec2(drew_relief_ ? reach : 0.0f, -1.0f));
-  frame.world->road.draw_visible(view_proj, frame.camera.position);
+  frame.world->road.draw_visible(view_proj, frame.camera.position, 1.0f,
+                                 drew_relief_ ? reach : 0.0f);
 }
 
 }  // namespace downpour::render
