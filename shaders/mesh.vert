@@ -1,3 +1,3 @@
 #version 450
-// Static meshes: the terrain, the vehicles (mesh_vertex.glsl).
+// Static meshes: the terrain, the street lights' poles (mesh_vertex.glsl).
 #include "mesh_vertex.glsl"

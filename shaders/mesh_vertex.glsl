@@ -1,5 +1,6 @@
 // A static mesh in world space (mesh.vert); with MESH_CURVATURE, its vertices' principal
-// curvatures and directions passed on for the relief shadows (road.vert).
+// curvatures and directions passed on for the relief shadows (road.vert); with MESH_WHEELS, a
+// vehicle or cabin model whose wheels turn (model.vert).
 #include "common.glsl"
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
@@ -18,14 +19,35 @@ out vec4 v_principal_dirs;
 // part, -1 the far (the same distance negated, so that the parts meet without a crack).
 uniform vec2 u_near_split;
 #endif
+#ifdef MESH_WHEELS
+// Wheel k's vertices [u_wheel_vertices[k].x, .y) turn about the axle through (x, z) =
+// u_wheel_turn[k].xy of the model's frame, by the angle whose cosine and sine are .zw
+// (model_meshes.hpp: the whole model in one draw).
+#define MAX_WHEELS 16
+uniform int u_wheel_count;
+uniform ivec2 u_wheel_vertices[MAX_WHEELS];
+uniform vec4 u_wheel_turn[MAX_WHEELS];
+#endif
 #ifdef ROAD_LANES
 layout(location = 5) in vec4 a_lane;  // mesh_data.hpp's VertexLane
 flat out vec4 v_strip;
 #endif
 void main() {
-  vec4 world = u_model * vec4(a_position, 1.0);
+  vec3 position = a_position, normal = a_normal;
+#ifdef MESH_WHEELS
+  for (int k = 0; k < u_wheel_count; ++k) {
+    ivec2 range = u_wheel_vertices[k];
+    if (gl_VertexID >= range.x && gl_VertexID < range.y) {
+      vec4 turn = u_wheel_turn[k];
+      vec2 p = position.xz - turn.xy;
+      position.xz = turn.xy + vec2(turn.z * p.x + turn.w * p.y, turn.z * p.y - turn.w * p.x);
+      normal.xz = vec2(turn.z * normal.x + turn.w * normal.z, turn.z * normal.z - turn.w * normal.x);
+    }
+  }
+#endif
+  vec4 world = u_model * vec4(position, 1.0);
   v_world = world.xyz;
-  v_normal = mat3(u_model) * a_normal;
+  v_normal = mat3(u_model) * normal;
   v_uv = a_uv;
   v_fog = fog_at(world.xyz);
 #ifdef MESH_CURVATURE

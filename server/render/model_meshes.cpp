@@ -1,5 +1,7 @@
 #include "server/render/model_meshes.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <glm/gtc/constants.hpp>
@@ -7,20 +9,91 @@
 
 namespace downpour::render {
 
-ModelMesh::ModelMesh(const model::VehicleModel& m)
-    : mesh(m.mesh), fixed(m.fixed_index_count), bonnet(m.bonnet_index_count), wheels(m.wheels) {}
+namespace {
 
-void ModelMesh::draw(const Uniform& u_model, const glm::mat4& model, double rolled_m,
-                     bool bonnet_only) const {
-  u_model.set(model);
-  mesh.draw(0, bonnet_only ? bonnet : fixed);
-  if (bonnet_only) return;
+// The vertices each wheel's triangles use, [lowest, highest + 1), where no other part's triangle
+// uses one in that range, the wheels' triangles follow the fixed parts' one after another, and
+// there are at most kMaxWheels wheels; else none.
+std::vector<glm::ivec2> wheel_vertex_ranges(const model::VehicleModel& m) {
+  const std::vector<model::Wheel>& wheels = m.wheels;
+  if (wheels.empty() || wheels.size() > static_cast<std::size_t>(ModelMesh::kMaxWheels)) return {};
+  std::uint32_t next = m.fixed_index_count;
   for (const model::Wheel& w : wheels) {
-    const double turns = rolled_m / (2.0 * glm::pi<double>() * w.radius_m);
-    const auto angle = static_cast<float>(2.0 * glm::pi<double>() * (turns - std::floor(turns)));
-    u_model.set(glm::translate(
-        glm::rotate(glm::translate(model, w.centre), angle, glm::vec3(0.0f, 1.0f, 0.0f)),
-        -w.centre));
+    if (w.first_index != next) return {};
+    next += w.index_count;
+  }
+  const std::vector<std::uint32_t>& indices = m.mesh.indices;
+  std::vector<glm::ivec2> ranges;
+  for (const model::Wheel& w : wheels) {
+    std::uint32_t lo = UINT32_MAX, hi = 0;
+    for (std::uint32_t k = w.first_index; k < w.first_index + w.index_count; ++k) {
+      lo = std::min(lo, indices[k]);
+      hi = std::max(hi, indices[k]);
+    }
+    if (lo > hi) lo = hi = 0;  // a wheel without triangles
+    ranges.emplace_back(static_cast<int>(lo), static_cast<int>(hi) + 1);
+  }
+  // Every index of the mesh lies in the range of its own wheel or in none.
+  for (std::size_t k = 0; k < indices.size(); ++k) {
+    const auto v = static_cast<int>(indices[k]);
+    for (std::size_t w = 0; w < wheels.size(); ++w) {
+      const bool own =
+          k >= wheels[w].first_index && k < wheels[w].first_index + wheels[w].index_count;
+      if (!own && v >= ranges[w].x && v < ranges[w].y) return {};
+    }
+  }
+  return ranges;
+}
+
+float wheel_angle(double rolled_m, const model::Wheel& w) {
+  const double turns = rolled_m / (2.0 * glm::pi<double>() * w.radius_m);
+  return static_cast<float>(2.0 * glm::pi<double>() * (turns - std::floor(turns)));
+}
+
+}  // namespace
+
+ModelUniforms::ModelUniforms(const ShaderProgram& program)
+    : model(program.uniform("u_model")),
+      wheel_count(program.uniform("u_wheel_count")),
+      wheel_vertices(program.uniform("u_wheel_vertices")),
+      wheel_turn(program.uniform("u_wheel_turn")) {}
+
+ModelMesh::ModelMesh(const model::VehicleModel& m)
+    : mesh(m.mesh),
+      fixed(m.fixed_index_count),
+      bonnet(m.bonnet_index_count),
+      wheels(m.wheels),
+      wheel_vertices(wheel_vertex_ranges(m)) {}
+
+void ModelMesh::draw(const ModelUniforms& u, const glm::mat4& model, double rolled_m,
+                     bool bonnet_only) const {
+  u.model.set(model);
+  if (bonnet_only || wheels.empty()) {
+    u.wheel_count.set(0);
+    mesh.draw(0, bonnet_only ? bonnet : fixed);
+    return;
+  }
+  if (!wheel_vertices.empty()) {
+    // The wheels follow the fixed parts in the indices: one draw.
+    std::array<glm::vec4, kMaxWheels> turn;
+    for (std::size_t k = 0; k < wheels.size(); ++k) {
+      const float a = wheel_angle(rolled_m, wheels[k]);
+      turn[k] = glm::vec4(wheels[k].centre.x, wheels[k].centre.z, std::cos(a), std::sin(a));
+    }
+    const auto n = static_cast<int>(wheels.size());
+    u.wheel_count.set(n);
+    u.wheel_vertices.set(wheel_vertices.data(), n);
+    u.wheel_turn.set(turn.data(), n);
+    const model::Wheel& last = wheels.back();
+    mesh.draw(0, last.first_index + last.index_count);
+    return;
+  }
+  u.wheel_count.set(0);
+  mesh.draw(0, fixed);
+  for (const model::Wheel& w : wheels) {
+    u.model.set(glm::translate(glm::rotate(glm::translate(model, w.centre),
+                                           wheel_angle(rolled_m, w), glm::vec3(0.0f, 1.0f, 0.0f)),
+                               -w.centre));
     mesh.draw(w.first_index, w.index_count);
   }
 }

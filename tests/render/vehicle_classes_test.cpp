@@ -12,6 +12,7 @@
 #include "server/model/default_models.hpp"
 #include "server/model/gltf_model.hpp"
 #include "server/render/cpu/camera.hpp"
+#include "server/render/model_meshes.hpp"
 #include "server/sim/pose.hpp"
 #include "server/sim/vehicle_class.hpp"
 #include "tests/render/render_fixture.hpp"
@@ -198,6 +199,115 @@ TEST_F(VehicleClassesTest, AModelReadFromGltfDrawsAsTheBuiltInOne) {
       mean, off, worst);
   EXPECT_LT(mean, 0.05);
   EXPECT_LT(off, 10);
+}
+
+// Each built-in model is one draw, its wheels turned in the vertex shader (model_meshes.hpp); a
+// model whose wheels do not follow its fixed parts in order is drawn a wheel at a time. Both turn
+// the wheels alike: a car seen from its side, rolled 0.37 m, drawn each way.
+TEST_F(VehicleClassesTest, WheelsTurnAlikeInTheShaderAndDrawnOneByOne) {
+  for (const sim::VehicleClass c : {sim::VehicleClass::kCar, sim::VehicleClass::kTruck,
+                                    sim::VehicleClass::kBus, sim::VehicleClass::kMotorbike}) {
+    const model::VehicleModel m = model::default_vehicle(c);
+    EXPECT_EQ(ModelMesh(m).wheel_vertices.size(), m.wheels.size()) << static_cast<int>(c);
+  }
+  model::VehicleModel reordered = model::default_vehicle(sim::VehicleClass::kCar);
+  std::reverse(reordered.wheels.begin(), reordered.wheels.end());
+  ASSERT_TRUE(ModelMesh(reordered).wheel_vertices.empty());
+
+  sim::SceneState s = dry_scene();
+  const sim::Track& track = sim::Track::built_in();
+  const double s0 = track.project(glm::dvec2(s.vehicle.position_m), 50.0).s;
+  const sim::VehicleLayout& layout = sim::vehicle_layout(sim::VehicleClass::kCar);
+  const sim::TrackFrame f = track.at(s0 + 25.0 - 0.5 * layout.size_m.x - layout.rear_m);
+  sim::TrafficVehicle v;
+  v.id = 4;
+  v.vehicle_class = sim::VehicleClass::kCar;
+  v.size_m = layout.size_m;
+  const glm::dvec2 xy = glm::dvec2(f.position) + f.left * track.lane_centre(0);
+  v.state.position_m = {xy.x, xy.y, track.surface_height(s0 + 25.0, track.lane_centre(0))};
+  v.state.rotation.yaw_deg = glm::degrees(f.heading_rad);
+  s.traffic = {v};
+  s.traffic_lights = {sim::VehicleLights{}};
+  s.traffic_rolled_m = {0.37};
+  const sim::ViewSpec spec =
+      posed_view(sim::View::kRoad, 640, 360, glm::dvec3(25.0, -7.0, 1.2), 90.0, -5.0, 34.0);
+  const RgbaImage in_shader = render(spec, s);
+  s.traffic[0].model = std::make_shared<const model::VehicleModel>(std::move(reordered));
+  s.traffic[0].size_m = glm::dvec3(s.traffic[0].model->size());
+  const RgbaImage one_by_one = render(spec, s);
+  sim::SceneState still = s;
+  still.traffic_rolled_m = {0.0};
+  const RgbaImage unturned = render(spec, still);
+  if (const char* dir = std::getenv("DOWNPOUR_TEST_IMAGES")) {
+    testing::write_png(std::string(dir) + "/wheels_in_shader.png", in_shader);
+    testing::write_png(std::string(dir) + "/wheels_one_by_one.png", one_by_one);
+  }
+  int off = 0, worst = 0, turned = 0;
+  for (std::size_t i = 0; i < in_shader.pixels.size(); ++i) {
+    if (i % 4 == 3) continue;
+    const int d = std::abs(in_shader.pixels[i] - one_by_one.pixels[i]);
+    worst = std::max(worst, d);
+    off += d > 8;
+    turned += std::abs(in_shader.pixels[i] - unturned.pixels[i]) > 12;
+  }
+  std::printf(
+      "wheels turned in the shader against one by one: %d channels off by more than 8 (largest "
+      "%d); %d channels differ from the wheels unturned\n",
+      off, worst, turned);
+  EXPECT_GT(turned, 30);  // the wheels did turn
+  EXPECT_LT(off, 10);
+}
+
+// A vehicle far off is drawn from its model for the distance (plain boxes), shaded as its full
+// model is: a truck 90 m ahead, its pixels' mean colour from each model.
+TEST_F(VehicleClassesTest, AVehicleForTheDistanceIsShadedAsItsFullModel) {
+  sim::SceneState s = dry_scene();
+  const sim::Track& track = sim::Track::built_in();
+  const double s0 = track.project(glm::dvec2(s.vehicle.position_m), 50.0).s;
+  const sim::TrackFrame f = track.at(s0 + 90.0);
+  sim::TrafficVehicle v;
+  v.id = 5;  // white
+  v.vehicle_class = sim::VehicleClass::kTruck;
+  v.size_m = sim::vehicle_layout(v.vehicle_class).size_m;
+  const glm::dvec2 xy = glm::dvec2(f.position) + f.left * track.lane_centre(0);
+  v.state.position_m = {xy.x, xy.y, track.surface_height(s0 + 90.0, track.lane_centre(0))};
+  v.state.rotation.yaw_deg = glm::degrees(f.heading_rad);
+  const sim::ViewSpec spec = sim::view_spec(sim::View::kCockpit, 640, 360);
+  const RgbaImage empty = render(spec, s);
+  s.traffic = {v};
+  s.traffic_lights = {sim::VehicleLights{}};
+  const RgbaImage far = render(spec, s);  // under 40 px tall: the model for the distance
+  // A named model is drawn in full at any distance.
+  s.traffic[0].model =
+      std::make_shared<const model::VehicleModel>(model::default_vehicle(v.vehicle_class));
+  s.traffic[0].size_m = glm::dvec3(s.traffic[0].model->size());
+  const RgbaImage full = render(spec, s);
+  if (const char* dir = std::getenv("DOWNPOUR_TEST_IMAGES")) {
+    testing::write_png(std::string(dir) + "/model_far.png", far);
+    testing::write_png(std::string(dir) + "/model_far_in_full.png", full);
+  }
+  const auto mean_over = [&](const RgbaImage& image) {
+    glm::dvec3 sum(0.0);
+    int n = 0;
+    for (std::size_t i = 0; i < image.pixels.size(); i += 4) {
+      int d = 0;
+      for (int k = 0; k < 3; ++k)
+        d = std::max(d, std::abs(image.pixels[i + k] - empty.pixels[i + k]));
+      if (d <= 12) continue;
+      sum += glm::dvec3(image.pixels[i], image.pixels[i + 1], image.pixels[i + 2]);
+      ++n;
+    }
+    return std::make_pair(n, n > 0 ? sum / static_cast<double>(n) : sum);
+  };
+  const auto [n_far, c_far] = mean_over(far);
+  const auto [n_full, c_full] = mean_over(full);
+  std::printf(
+      "the truck 90 m ahead: %d pixels from the far model, mean %.0f %.0f %.0f; %d in full, "
+      "mean %.0f %.0f %.0f\n",
+      n_far, c_far.r, c_far.g, c_far.b, n_full, c_full.r, c_full.g, c_full.b);
+  ASSERT_GT(n_full, 100);
+  EXPECT_NEAR(n_far, n_full, 0.15 * n_full);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(c_far[k], c_full[k], 12.0) << k;
 }
 
 // The changed pixels' columns (x0, x1) and rows (y0, y1) of an image against another.

@@ -78,6 +78,9 @@ class Uniform {
   void set(const glm::vec4* v, int count) const {
     glProgramUniform4fv(program_, location_, count, &v->x);
   }
+  void set(const glm::ivec2* v, int count) const {
+    glProgramUniform2iv(program_, location_, count, &v->x);
+  }
 
  private:
   GLuint program_ = 0;
@@ -109,6 +112,9 @@ class Mesh {
   void draw() const;
   // Indices [first_index, first_index + count) alone.
   void draw(std::uint32_t first_index, std::uint32_t count) const;
+  // Several index ranges in one call (glMultiDrawElements): counts[k] indices from byte offset
+  // offsets[k] each.
+  void multi_draw(const GLsizei* counts, const void* const* offsets, GLsizei draws) const;
   bool empty() const { return index_count_ == 0; }
   std::size_t triangles() const { return static_cast<std::size_t>(index_count_) / 3; }
   glm::vec3 bounds_min{0.0f};

@@ -20,10 +20,10 @@ class CockpitPass final : public Pass {
                        {Resource::kViewColour, Resource::kViewDepth},
                        {DepthTest::kNearer, true, Blend::kOff}};
   ShaderProgram program_;
-  Uniform u_model_;
+  ModelUniforms uniforms_;
   sim::GlassConfig built_for_;
-  Mesh interior_;      // the built-in cabin round the glass
-  ModelMeshes named_;  // the cabin models sessions name
+  ModelMesh interior_;  // the built-in cabin round the glass
+  ModelMeshes named_;   // the cabin models sessions name
 };
 
 }  // namespace downpour::render

@@ -12,8 +12,8 @@
 namespace downpour::render {
 
 VehiclePass::VehiclePass(SharedResources&)
-    : program_("mesh.vert", "vehicle.frag"),
-      u_model_(program_.uniform("u_model")),
+    : program_("model.vert", "vehicle.frag"),
+      uniforms_(program_),
       u_body_colour_(program_.uniform("u_body_colour")),
       u_lamps_(program_.uniform("u_lamps")),
       u_head_(program_.uniform("u_head")) {
@@ -51,7 +51,7 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
   prepare(glm::vec3(0.42f, 0.05f, 0.04f), shown_lights(frame.scene.ego_lights, weather), flash_on);
   const auto car = static_cast<std::size_t>(sim::VehicleClass::kCar);
   (ego_model ? named_.get(ego_model) : near_[car])
-      .draw(u_model_, glm::scale(frame.vehicle_to_world, ego_scale), frame.scene.ego_rolled_m,
+      .draw(uniforms_, glm::scale(frame.vehicle_to_world, ego_scale), frame.scene.ego_rolled_m,
             cockpit);
   // A vehicle under 40 pixels tall is drawn from its model for the distance.
   const float pixels_per_radian = 0.5f * static_cast<float>(frame.spec.height) /
@@ -84,7 +84,7 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
         static_cast<float>(other.size_m.z) * pixels_per_radian < 40.0f * std::max(distance, 0.1f);
     const auto c = static_cast<std::size_t>(other.vehicle_class);
     const ModelMesh& shape = other.model ? named_.get(other.model) : small ? far_[c] : near_[c];
-    shape.draw(u_model_, model, rolled, false);
+    shape.draw(uniforms_, model, rolled, false);
   }
 }
 

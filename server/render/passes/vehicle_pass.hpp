@@ -26,7 +26,8 @@ class VehiclePass final : public Pass {
                        {Resource::kViewColour, Resource::kViewDepth},
                        {DepthTest::kNearer, true, Blend::kOff}};
   ShaderProgram program_;
-  Uniform u_model_, u_body_colour_, u_lamps_, u_head_;
+  ModelUniforms uniforms_;
+  Uniform u_body_colour_, u_lamps_, u_head_;
   // Each class's built-in model in full and for the distance (default_models.hpp's Detail): by
   // class. The models sessions name, as their scenes hold them.
   std::vector<ModelMesh> near_, far_;
