@@ -59,6 +59,8 @@ vec3 lamp_lux(int i, vec3 p, vec3 n) {
 // The lamps' light on an upward surface at p, as radiance per unit albedo: the lamp map's fine
 // ring where it holds p (fading over its last 4 cells), else its coarse one (lamp_map.hpp).
 vec3 lamp_ground(vec3 p) {
+  // Without a lamp map (by day) the same for every pixel: no fetches.
+  if (frame.lamp_map.x < 0.5) return vec3(0.0);
   vec4 r0 = frame.lamp_rings[0], r1 = frame.lamp_rings[1];
   vec2 uv0 = (p.xy - r0.xy) * r0.z, uv1 = (p.xy - r1.xy) * r1.z;
   vec2 e0 = min(uv0, 1.0 - uv0), e1 = min(uv1, 1.0 - uv1);
@@ -66,7 +68,7 @@ vec3 lamp_ground(vec3 p) {
   float in1 = clamp(min(e1.x, e1.y) * 32.0, 0.0, 1.0);
   vec3 fine = texture(lamp_map_tex, vec3(uv0, 0.0)).rgb;
   vec3 coarse = texture(lamp_map_tex, vec3(uv1, 1.0)).rgb;
-  return mix(coarse * in1, fine, in0) * step(0.5, frame.lamp_map.x);
+  return mix(coarse * in1, fine, in0);
 }
 
 // The lamps' light that water in the air at p scatters towards the eye (to_eye: unit, from p):
