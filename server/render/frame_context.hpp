@@ -36,8 +36,10 @@ struct FrameContext {
   // The state after this frame's step; waits for the step. Only passes that declare
   // PassDecl::reads_step call it (through water() and rain()).
   std::function<const sim::SceneState&()> stepped;
-  // Chunked geometry takes its level of detail as from this many times as far (the road
-  // reflection, at a quarter of the view's size, needs a quarter of the detail).
+  // Chunked geometry takes its level of detail as from this many times as far: a view's pixel
+  // angle over that of COCKPIT at 720 rows (detail_distance_scale()), the geometry's levels'
+  // distances being set for that. (The road reflection, at a quarter of the view's size, needs a
+  // quarter of its view's detail; an environment face, as its texels' angle says.)
   float detail_distance_scale = 1.0f;
   // The frame's lamps (light_set.hpp), once the renderer has made them: for the passes that light
   // what the lamp map does not hold (the rain's drops).
@@ -102,5 +104,10 @@ std::unique_ptr<SharedResources> make_shared_resources();
 
 // Axis-aligned box against the view frustum's side and near planes.
 bool box_visible(const glm::mat4& view_proj, const glm::vec3& lo, const glm::vec3& hi);
+
+// FrameContext::detail_distance_scale for pixels (or texels) pixel_rad wide: as many times as
+// COCKPIT's at 720 rows (60 degrees), at least 1. A 640x360 COCKPIT takes its terrain's 40 m cells
+// from 100 m on, where 1280x720 takes them from 200 m: the same pixels a cell.
+float detail_distance_scale(double pixel_rad);
 
 }  // namespace downpour::render

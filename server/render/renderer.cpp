@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstddef>
 #include <cstdio>
 #include <cstring>
@@ -118,9 +119,7 @@ struct Renderer::Impl {
     r.view_fbo = probe.face_fbo();
     r.view_colour = {probe.face_colour(), size, size};
     r.view_depth = {probe.face_depth(), size, size};
-    // Geometry's detail as far out as a face's texels are wider than the view's pixels.
-    const float view_pixel = 2.0f * static_cast<float>(f.camera.tan_half_fov_y) /
-                             static_cast<float>(std::max(f.spec.height, 1));
+    // Geometry's detail as the faces' texels call for (a 90-degree face of `size` texels).
     const float face_texel = 2.0f / static_cast<float>(size);
     const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
     const float zero_depth = 0.0f;
@@ -134,7 +133,7 @@ struct Renderer::Impl {
                       f.stepped};
       ff.world = f.world;
       ff.lights = f.lights;
-      ff.detail_distance_scale = std::max(face_texel / view_pixel, 1.0f);
+      ff.detail_distance_scale = detail_distance_scale(face_texel);
       ff.picture_camera = &f.camera;
       block->upload(ff, water_block(ff, block->view_water().mirror, false));
       apply(RenderState{DepthTest::kOff, true, Blend::kOff});
@@ -440,6 +439,8 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
       GlassView(camera, scene.glass, spec.height, m.min_glass_layer_scale, m.glass_layer_widening),
       stepped};
   frame.world = &m.worlds.get(scene.roads);
+  frame.detail_distance_scale =
+      detail_distance_scale(2.0 * camera.tan_half_fov_y / std::max(spec.height, 1));
   if (new_target) m.prepare(frame);
   FrameResources resources;
   resources.view_fbo = target->fbo.id();
@@ -668,6 +669,11 @@ bool box_visible(const glm::mat4& m, const glm::vec3& lo, const glm::vec3& hi) {
     if (p.x * c.x + p.y * c.y + p.z * c.z + p.w < 0.0f) return false;
   }
   return true;
+}
+
+float detail_distance_scale(double pixel_rad) {
+  static const double reference = 2.0 * std::tan(30.0 * 3.14159265358979 / 180.0) / 720.0;
+  return static_cast<float>(std::max(pixel_rad / reference, 1.0));
 }
 
 }  // namespace downpour::render

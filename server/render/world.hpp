@@ -13,9 +13,10 @@
 
 namespace downpour::render {
 
-// Street lights farther than this are not drawn (a pole there is a fifth of a pixel wide at 640 x
-// 360; at night the lamp_glow pass still draws its lens), times the frame's detail distance scale.
-inline constexpr float kStreetLightsDrawnWithin_m = 350.0f;
+// Street lights farther than this are not drawn (a pole there is a fifth of a pixel wide at 1280 x
+// 720; at night the lamp_glow pass still draws its lens), over the frame's detail distance scale
+// (350 m at 640 x 360).
+inline constexpr float kStreetLightsDrawnWithin_m = 700.0f;
 
 struct World {
   std::vector<sim::StreetLight> street_lights;  // sim/lights.hpp

@@ -97,12 +97,13 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
     mean_lit_[plain + 3].set(mean_lit);
     near_split_[plain + 3].set(glm::vec2(reach, 1.0f));
     // (Only the chunks that reach into the near part, and then those that reach beyond it.)
-    frame.world->road.draw_visible(view_proj, frame.camera.position, 1.0f, 0.0f, reach);
+    frame.world->road.draw_visible(view_proj, frame.camera.position, frame.detail_distance_scale,
+                                   0.0f, reach);
   }
   programs_[plain].use();
   mean_lit_[plain].set(mean_lit);
   near_split_[plain].set(glm::vec2(drew_relief_ ? reach : 0.0f, -1.0f));
-  frame.world->road.draw_visible(view_proj, frame.camera.position, 1.0f,
+  frame.world->road.draw_visible(view_proj, frame.camera.position, frame.detail_distance_scale,
                                  drew_relief_ ? reach : 0.0f);
 }
 

@@ -24,7 +24,7 @@ void RoadReflectionPass::execute(const FrameContext& f, const FrameResources& r)
   mirrored.position = glm::vec3(mirror.matrix * glm::vec4(f.camera.position, 1.0f));
   FrameContext mf{f.scene, f.spec, mirrored, f.atmosphere, f.vehicle_to_world, f.glass, f.stepped};
   // At a quarter of the view's size it needs a quarter of the detail.
-  mf.detail_distance_scale = static_cast<float>(kRoadReflectionScale);
+  mf.detail_distance_scale = f.detail_distance_scale * static_cast<float>(kRoadReflectionScale);
   mf.world = f.world;
   block_.upload(mf, WaterBlock{});
   for (const Reflected& pass : reflected_) {

@@ -8,9 +8,9 @@ namespace downpour::render {
 // The roads' street lights (sim/lights.hpp; their meshes built in scene_geometry.hpp, kept in
 // world.hpp): a pole on the verge, an arm over the road and a lamp at its end, whose lens glows
 // when the lights are on (their light on the ground is the lamp map's). Static geometry in chunks
-// of four poles, culled against the view and beyond kStreetLightsDrawnWithin_m (world.hpp) times
+// of four poles, culled against the view and beyond kStreetLightsDrawnWithin_m (world.hpp) over
 // the frame's detail distance scale (the road's mirror, at a quarter of the size, stops at a
-// quarter of it); mirrored in the wet road with the cars.
+// quarter of its view's); mirrored in the wet road with the cars.
 class StreetLightPass final : public Pass {
  public:
   explicit StreetLightPass(SharedResources& shared);
