@@ -379,18 +379,34 @@ VehicleModel default_vehicle(sim::VehicleClass c, Detail detail) {
       break;
     case sim::VehicleClass::kCar:
       m = car(detail);
-      mark_bonnet(m, static_cast<float>(sim::GlassConfig{}.bottom_left_m.x) - 0.05f);
+      mark_bonnet(m);
       break;
   }
   return m;
 }
 
-void mark_bonnet(VehicleModel& model, float ahead_of_x) {
+void mark_bonnet(VehicleModel& model, const sim::GlassConfig& glass, const glm::dvec3& eye_m) {
   std::vector<std::uint32_t>& idx = model.mesh.indices;
+  const glm::vec3 eye(eye_m);
+  const glm::vec3 foot(glass.bottom_left_m);
+  const float ahead_of_x = foot.x - 0.05f;
+  // The sight line's slope (dz / dx) from the eye over the foot, lowered by 6 degrees.
+  const float sight = std::tan(std::atan2(foot.z - eye.z, foot.x - eye.x) - 0.105f);
   auto ahead = [&](std::size_t t) {
-    for (int k = 0; k < 3; ++k)
-      if (model.mesh.vertices[idx[t + k]].position.x < ahead_of_x) return false;
-    return model.mesh.vertices[idx[t]].uv.x != material::kGlass;
+    glm::vec3 normal(0.0f), centre(0.0f);
+    bool above = false;
+    for (int k = 0; k < 3; ++k) {
+      const render::MeshVertex& v = model.mesh.vertices[idx[t + k]];
+      if (v.position.x < ahead_of_x) return false;
+      normal += v.normal;
+      centre += v.position / 3.0f;
+      above = above || v.position.z - eye.z > sight * (v.position.x - eye.x);
+    }
+    // Facing the eye, or turned away by less than 20 degrees past grazing: at a silhouette the
+    // smooth vertex normals turn further than the flat triangle does.
+    const float facing = glm::dot(normal, eye - centre) /
+                         std::max(glm::length(normal) * glm::length(eye - centre), 1e-6f);
+    return above && facing > -0.35f && model.mesh.vertices[idx[t]].uv.x != material::kGlass;
   };
   std::vector<std::uint32_t> first, rest;
   for (std::size_t t = 0; t + 2 < model.fixed_index_count; t += 3)

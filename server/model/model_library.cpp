@@ -74,8 +74,7 @@ std::shared_ptr<const VehicleModel> ModelLibrary::load(const std::string& name, 
   try {
     VehicleModel read = read_gltf_file(path, kind, limits_);
     // From the driver's seat, a body shows what lies ahead of the (default car's) windshield.
-    if (kind == ModelKind::kVehicle)
-      mark_bonnet(read, static_cast<float>(sim::GlassConfig{}.bottom_left_m.x) - 0.05f);
+    if (kind == ModelKind::kVehicle) mark_bonnet(read);
     model = std::make_shared<const VehicleModel>(std::move(read));
   } catch (const ModelError& e) {
     *refusal = {Failure::kInvalid, "the model \"" + name + "\": " + e.what()};
