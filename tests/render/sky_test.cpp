@@ -1,6 +1,7 @@
 // The sky as the driver sees it under a clear sky (the scattered sky, sky_table.hpp): a warm
 // horizon towards a low sun and not away from it, blue at noon, the twilight's glow low over where
 // the sun set, and a sky unchanged under full cloud.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -11,6 +12,7 @@
 
 #include "server/render/cpu/camera.hpp"
 #include "tests/render/render_fixture.hpp"
+#include "tests/render/windshield_fixture.hpp"
 
 namespace downpour::render {
 namespace {
@@ -88,6 +90,49 @@ TEST_F(SkyTest, FullCloudHidesTheScattering) {
   const sim::SceneState a = scene(3.0, 0.0, 1.0), b = scene(3.0, 180.0, 1.0);
   const glm::dvec3 ca = ahead(shot(a, "cloud_a"), a, 10.0), cb = ahead(shot(b, "cloud_b"), b, 10.0);
   EXPECT_NEAR(ca.x - ca.z, cb.x - cb.z, 2.0);
+}
+
+// Glare through the wet glass: towards a sun 4 degrees up, each drop (a small lens with a wide
+// field) near the sun's image shows a bright point of it, as the lamps make them do at night. The
+// glass beaded with the golden windshield's water against the same glass dry, the sun ahead and
+// the sun behind: the pixels the water makes brighter by 40 levels, within 90 px of the sun's
+// image (or of where it would be ahead).
+TEST_F(SkyTest, TowardsALowSunTheWetGlassGlares) {
+  const sim::ViewSpec spec = sim::view_spec(sim::View::kCockpit, kW, kH);
+  const auto glare = [&](double from_ahead_deg, const std::string& name) {
+    sim::SceneState dry = scene(4.0, from_ahead_deg, 0.0);
+    sim::SceneState wet = dry;
+    wet.windshield = testing::golden_windshield(wet.glass);
+    const RgbaImage a = shot(wet, name + "_wet"), b = shot(dry, name + "_dry");
+    // Where the sun would show ahead: 4 degrees up, 6 to the right of straight ahead.
+    const Camera camera = make_camera(spec, dry.vehicle);
+    const double yaw = glm::radians(dry.vehicle.rotation.yaw_deg + std::min(from_ahead_deg, 6.0)),
+                 e = glm::radians(4.0);
+    const glm::vec3 dir(std::cos(e) * std::cos(yaw), std::cos(e) * std::sin(yaw), std::sin(e));
+    const glm::vec4 clip =
+        camera.projection * camera.view * glm::vec4(camera.position + 1e4f * dir, 1.0f);
+    const int sx = static_cast<int>((clip.x / clip.w * 0.5f + 0.5f) * kW);
+    const int sy = static_cast<int>((0.5f - clip.y / clip.w * 0.5f) * kH);
+    int lit = 0;
+    for (int y = 0; y < kH; ++y) {
+      for (int x = 0; x < kW; ++x) {
+        if ((x - sx) * (x - sx) + (y - sy) * (y - sy) > 90 * 90) continue;
+        const std::size_t i = (static_cast<std::size_t>(y) * kW + x) * 4;
+        const int d = (a.pixels[i] + a.pixels[i + 1] + a.pixels[i + 2] - b.pixels[i] -
+                       b.pixels[i + 1] - b.pixels[i + 2]) /
+                      3;
+        lit += d > 40;
+      }
+    }
+    std::printf(
+        "the sun %.0f degrees round from ahead, 4 up (at %d, %d): %d pixels the water "
+        "lights\n",
+        from_ahead_deg, sx, sy, lit);
+    return lit;
+  };
+  const int ahead = glare(6.0, "glare_ahead"), behind = glare(180.0, "glare_behind");
+  EXPECT_GT(ahead, 40);
+  EXPECT_GT(ahead, 5 * behind + 20);
 }
 
 }  // namespace
