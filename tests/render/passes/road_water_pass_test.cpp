@@ -106,6 +106,38 @@ TEST_F(RoadWaterPassTest, RoadDarkensFromDryToWet) {
   EXPECT_LT(wet, dry * 0.87) << "dry " << dry << ", wet " << wet;
 }
 
+// Wet markings: on the flooded road (5 minutes of 30 mm/h, the rain just stopped) the lane
+// markings darken, and they no longer stand out of the road as they do dry: the water's mirror
+// lies over paint and asphalt alike. In the chase view's lower half, the pixels that are markings
+// on the dry road (luma over 120) and the asphalt (under 90), each set's mean luma dry and flooded.
+TEST_F(RoadWaterPassTest, MarkingsDarkenAndMirrorAsTheAsphaltDoes) {
+  const RgbaImage dry = render(sim::View::kRoad, after_rain(false)),
+                  wet = render(sim::View::kRoad, after_rain(true));
+  testing::write_png(::testing::TempDir() + "markings_dry.png", dry);
+  testing::write_png(::testing::TempDir() + "markings_wet.png", wet);
+  double paint[2] = {0.0, 0.0}, asphalt[2] = {0.0, 0.0};
+  int n_paint = 0, n_asphalt = 0;
+  for (int y = kHeight / 2; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      const double d = testing::mean_luma(dry, x, y, x + 1, y + 1) * 255.0;
+      const double w = testing::mean_luma(wet, x, y, x + 1, y + 1) * 255.0;
+      if (d > 120.0) paint[0] += d, paint[1] += w, ++n_paint;
+      if (d < 90.0) asphalt[0] += d, asphalt[1] += w, ++n_asphalt;
+    }
+  }
+  ASSERT_GT(n_paint, 100);
+  const double paint_ratio = paint[1] / paint[0], asphalt_ratio = asphalt[1] / asphalt[0];
+  std::printf(
+      "markings (%d px): luma %.1f dry, %.1f flooded (x%.2f); asphalt (%d px): %.1f dry, "
+      "%.1f flooded (x%.2f)\n",
+      n_paint, paint[0] / n_paint, paint[1] / n_paint, paint_ratio, n_asphalt,
+      asphalt[0] / n_asphalt, asphalt[1] / n_asphalt, asphalt_ratio);
+  // The paint darkens; the asphalt's mirror of the bright sky makes up for its own darkening, so
+  // the markings' contrast against it falls by a quarter or more.
+  EXPECT_LT(paint_ratio, 0.85);
+  EXPECT_LT(paint_ratio / asphalt_ratio, 0.75);
+}
+
 TEST_F(RoadWaterPassTest, TailLightsAreMirroredBelowTheCarOnAWetRoad) {
   // The chase camera's car: its lamps are red on the image's middle columns; below the car, on a
   // wet road, their mirror images. In a downpour under full cloud: a lamp outshines a bright
