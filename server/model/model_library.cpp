@@ -73,7 +73,8 @@ std::shared_ptr<const VehicleModel> ModelLibrary::load(const std::string& name, 
   std::shared_ptr<const VehicleModel> model;
   try {
     VehicleModel read = read_gltf_file(path, kind, limits_);
-    // From the driver's seat, a body shows what lies ahead of the (default car's) windshield.
+    // From the driver's seat, a body shows what the driver sees past the default car's windshield
+    // (rpc/models.cpp marks a copy for a session with another glass or eye).
     if (kind == ModelKind::kVehicle) mark_bonnet(read);
     model = std::make_shared<const VehicleModel>(std::move(read));
   } catch (const ModelError& e) {

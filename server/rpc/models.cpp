@@ -1,5 +1,6 @@
 #include "server/rpc/models.hpp"
 
+#include "server/model/default_models.hpp"
 #include "server/rpc/validation.hpp"
 
 namespace downpour::rpc {
@@ -38,17 +39,11 @@ grpc::Status to_traffic_models(model::ModelLibrary& library, const v1::Update& i
   return grpc::Status::OK;
 }
 
-grpc::Status to_ego_models(model::ModelLibrary& library, const v1::EgoVehicle& in,
-                           const std::string& field, session::SessionConfig* config) {
-  if (!in.body_model().empty()) {
-    if (auto s = load(library, in.body_model(), model::ModelKind::kVehicle, field + ".body_model",
-                      &config->ego.body_model);
-        !s.ok())
-      return s;
-    // Without a size of its own, the car is as large as its model.
-    if (in.size_m().x() == 0.0 && in.size_m().y() == 0.0 && in.size_m().z() == 0.0)
-      config->ego.size_m = glm::dvec3(config->ego.body_model->size());
-  }
+namespace {
+
+// The cabin model into config->ego, and the session's glass from it where the request gives none.
+grpc::Status to_cabin_model(model::ModelLibrary& library, const v1::EgoVehicle& in,
+                            const std::string& field, session::SessionConfig* config) {
   if (in.cabin_model().empty()) return grpc::Status::OK;
   const std::string f = field + ".cabin_model";
   if (auto s =
@@ -65,6 +60,32 @@ grpc::Status to_ego_models(model::ModelLibrary& library, const v1::EgoVehicle& i
   if (const auto why = model::glass_disagreement(*outline, config->glass))
     return {grpc::StatusCode::INVALID_ARGUMENT,
             f + ": " + *why + (in.has_windshield() ? " (" + field + ".windshield)" : "")};
+  return grpc::Status::OK;
+}
+
+}  // namespace
+
+grpc::Status to_ego_models(model::ModelLibrary& library, const v1::EgoVehicle& in,
+                           const std::string& field, session::SessionConfig* config) {
+  if (!in.body_model().empty()) {
+    if (auto s = load(library, in.body_model(), model::ModelKind::kVehicle, field + ".body_model",
+                      &config->ego.body_model);
+        !s.ok())
+      return s;
+    // Without a size of its own, the car is as large as its model.
+    if (in.size_m().x() == 0.0 && in.size_m().y() == 0.0 && in.size_m().z() == 0.0)
+      config->ego.size_m = glm::dvec3(config->ego.body_model->size());
+  }
+  if (auto s = to_cabin_model(library, in, field, config); !s.ok()) return s;
+  // The library marks a body's bonnet for the default glass and eye (what the driver sees past
+  // the glass's foot); a session with another glass or eye gets a copy marked for its own.
+  const sim::ModelPtr& body = config->ego.body_model;
+  if (body && (!model::same_cabin(config->glass, sim::GlassConfig{}) ||
+               config->ego.eye_m != sim::EgoGeometry{}.eye_m)) {
+    auto own = std::make_shared<model::VehicleModel>(*body);
+    model::mark_bonnet(*own, config->glass, config->ego.eye_m);
+    config->ego.body_model = std::move(own);
+  }
   return grpc::Status::OK;
 }
 

@@ -21,7 +21,8 @@ grpc::Status to_traffic_models(model::ModelLibrary& library, const v1::Update& i
                                const std::string& field, sim::Update* out);
 // The ego car's body and cabin models into config->ego, and the session's glass: the request's
 // windshield (config->glass as to_session_config read it), else the cabin model's, else the
-// default car's; a cabin whose windshield disagrees with the request's is refused.
+// default car's; a cabin whose windshield disagrees with the request's is refused. A body seen from
+// a glass or an eye not the default car's has its bonnet marked for them (mark_bonnet).
 grpc::Status to_ego_models(model::ModelLibrary& library, const v1::EgoVehicle& in,
                            const std::string& field, session::SessionConfig* config);
 

@@ -50,8 +50,21 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
   const glm::vec3 ego_scale = cockpit ? glm::vec3(1.0f) : glm::vec3(frame.scene.ego.size_m) / made;
   prepare(glm::vec3(0.42f, 0.05f, 0.04f), shown_lights(frame.scene.ego_lights, weather), flash_on);
   const auto car = static_cast<std::size_t>(sim::VehicleClass::kCar);
-  (ego_model ? named_.get(ego_model) : near_[car])
-      .draw(uniforms_, glm::scale(frame.vehicle_to_world, ego_scale), frame.scene.ego_rolled_m,
+  const ModelMesh* ego = ego_model ? &named_.get(ego_model) : &near_[car];
+  const sim::GlassConfig& glass = frame.scene.glass;
+  const glm::dvec3& eye = frame.scene.ego.eye_m;
+  if (cockpit && !ego_model &&
+      (!model::same_cabin(glass, sim::GlassConfig{}) || eye != sim::EgoGeometry{}.eye_m)) {
+    if (!own_bonnet_ || !model::same_cabin(glass, own_bonnet_glass_) || eye != own_bonnet_eye_) {
+      model::VehicleModel m = model::default_vehicle(sim::VehicleClass::kCar);
+      model::mark_bonnet(m, glass, eye);
+      own_bonnet_ = std::make_unique<ModelMesh>(m);
+      own_bonnet_glass_ = glass;
+      own_bonnet_eye_ = eye;
+    }
+    ego = own_bonnet_.get();
+  }
+  ego->draw(uniforms_, glm::scale(frame.vehicle_to_world, ego_scale), frame.scene.ego_rolled_m,
             cockpit);
   // A vehicle under 40 pixels tall is drawn from its model for the distance.
   const float pixels_per_radian = 0.5f * static_cast<float>(frame.spec.height) /

@@ -35,10 +35,20 @@ std::optional<float> hit(const glm::vec3& o, const glm::vec3& d, const glm::vec3
 // Rays from the driver's eye over the car's front, above the sight line over the glass's foot (the
 // dash hides what is under it): the first triangle each meets, among all the car's fixed ones but
 // the glass it looks through, is one of the bonnet's, wherever it is ahead of the foot.
-TEST(DefaultModelsTest, TheBonnetHoldsEveryTriangleTheDriverSeesPastTheGlass) {
-  const VehicleModel car = default_vehicle(sim::VehicleClass::kCar);
-  const sim::GlassConfig glass;
-  const glm::vec3 eye(sim::EgoGeometry{}.eye_m), foot(glass.bottom_left_m);
+// For the default car's glass and eye, and for others a session may give (its bonnet marked for
+// them, as rpc/models.cpp and the vehicle pass do): an eye 10 cm higher and further forward, and
+// a glass whose foot sits 15 cm further back. (The bonnet takes in, besides, the triangles that
+// reach past the foot under its height plus 5 cm: the scuttle that a glass set back shows.)
+class BonnetTest : public ::testing::TestWithParam<int> {};
+
+TEST_P(BonnetTest, TheBonnetHoldsEveryTriangleTheDriverSeesPastTheGlass) {
+  VehicleModel car = default_vehicle(sim::VehicleClass::kCar);
+  sim::GlassConfig glass;
+  glm::dvec3 eye_m = sim::EgoGeometry{}.eye_m;
+  if (GetParam() == 1) eye_m += glm::dvec3(0.1, 0.0, 0.1);
+  if (GetParam() == 2) glass.bottom_left_m.x -= 0.15;
+  if (GetParam() != 0) mark_bonnet(car, glass, eye_m);
+  const glm::vec3 eye(eye_m), foot(glass.bottom_left_m);
   const auto& v = car.mesh.vertices;
   const auto& idx = car.mesh.indices;
   ASSERT_GT(car.bonnet_index_count, 0u);
@@ -72,12 +82,17 @@ TEST(DefaultModelsTest, TheBonnetHoldsEveryTriangleTheDriverSeesPastTheGlass) {
     }
   }
   std::printf(
-      "the bonnet: %u of %u fixed triangles; %d rays meet the car past the foot, %d of them "
-      "on the bonnet's triangles\n",
-      car.bonnet_index_count / 3, car.fixed_index_count / 3, rays, on_bonnet);
+      "case %d, the bonnet: %u of %u fixed triangles; %d rays meet the car past the foot, "
+      "%d of them on the bonnet's triangles\n",
+      GetParam(), car.bonnet_index_count / 3, car.fixed_index_count / 3, rays, on_bonnet);
   EXPECT_GT(rays, 3000);
-  EXPECT_EQ(missed, 0);
+  // With the glass 15 cm behind the body's own windshield, the roots of the body's A-pillars stand
+  // at the glass's lower corners (a clash of body and glass, not of the bonnet's marking): up to 1%
+  // of the rays meet them.
+  EXPECT_LE(missed, GetParam() == 2 ? rays / 100 : 0);
 }
+
+INSTANTIATE_TEST_SUITE_P(DefaultModelsTest, BonnetTest, ::testing::Values(0, 1, 2));
 
 }  // namespace
 }  // namespace downpour::model
