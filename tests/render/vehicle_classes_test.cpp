@@ -310,6 +310,31 @@ TEST_F(VehicleClassesTest, AVehicleForTheDistanceIsShadedAsItsFullModel) {
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(c_far[k], c_full[k], 12.0) << k;
 }
 
+// From the driver's seat the bonnet follows the session's glass: with the glass's foot 15 cm
+// further back (the cabin built round it), the bonnet shows as much red as with the default glass,
+// none of it missing where the default bonnet's triangles would have ended.
+TEST_F(VehicleClassesTest, TheBonnetFollowsTheSessionsGlass) {
+  const auto red = [](const RgbaImage& image) {
+    int n = 0;
+    for (std::size_t i = 0; i < image.pixels.size(); i += 4)
+      n += image.pixels[i] > image.pixels[i + 1] + 8 && image.pixels[i] > image.pixels[i + 2] + 8;
+    return n;
+  };
+  sim::SceneState s = dry_scene();
+  const sim::ViewSpec spec = sim::view_spec(sim::View::kCockpit, 640, 360);
+  const RgbaImage usual = render(spec, s);
+  s.glass.bottom_left_m.x -= 0.15;
+  const RgbaImage back = render(spec, s);
+  if (const char* dir = std::getenv("DOWNPOUR_TEST_IMAGES")) {
+    testing::write_png(std::string(dir) + "/bonnet_default_glass.png", usual);
+    testing::write_png(std::string(dir) + "/bonnet_glass_back.png", back);
+  }
+  std::printf("the bonnet's red pixels: %d with the default glass, %d with the glass 15 cm back\n",
+              red(usual), red(back));
+  EXPECT_GT(red(usual), 2000);
+  EXPECT_GT(red(back), red(usual) * 9 / 10);
+}
+
 // The changed pixels' columns (x0, x1) and rows (y0, y1) of an image against another.
 glm::ivec4 changed_box(const RgbaImage& image, const RgbaImage& base) {
   glm::ivec4 box(image.width, -1, image.height, -1);
