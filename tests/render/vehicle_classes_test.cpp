@@ -25,12 +25,30 @@ using testing::RgbaImage;
 constexpr int kWidth = 320;
 constexpr int kHeight = 180;
 
-class VehicleClassesTest : public testing::RenderTest {};
+class VehicleClassesTest : public testing::RenderTest {
+ protected:
+  // A vehicle of class c in the ego car's lane of the built-in track, ahead_m along it from the ego
+  // car: its middle there (middle) or its origin, on the road's surface.
+  static sim::TrafficVehicle in_lane(const sim::SceneState& s, sim::VehicleClass c, int id,
+                                     double ahead_m, bool middle) {
+    const sim::Track& track = sim::Track::built_in();
+    const double s0 = track.project(glm::dvec2(s.vehicle.position_m), 50.0).s;
+    const sim::VehicleLayout& layout = sim::vehicle_layout(c);
+    const sim::TrackFrame f =
+        track.at(s0 + ahead_m - (middle ? 0.5 * layout.size_m.x + layout.rear_m : 0.0));
+    sim::TrafficVehicle v;
+    v.id = id;
+    v.vehicle_class = c;
+    v.size_m = layout.size_m;
+    const glm::dvec2 xy = glm::dvec2(f.position) + f.left * track.lane_centre(0);
+    v.state.position_m = {xy.x, xy.y, track.surface_height(s0 + ahead_m, track.lane_centre(0))};
+    v.state.rotation.yaw_deg = glm::degrees(f.heading_rad);
+    return v;
+  }
+};
 
 TEST_F(VehicleClassesTest, EachClassStandsAsLongAndTallAsItsSize) {
   const sim::SceneState base = dry_scene();
-  const sim::Track& track = sim::Track::built_in();
-  const double s0 = track.project(glm::dvec2(base.vehicle.position_m), 50.0).s;
   // The vehicle's middle 25 m ahead in the lane left of the ego car's; the camera 16 m to its
   // right side, 2 m up, looking square at it (the ego car's frame: yaw 90 looks left).
   const sim::ViewSpec spec =
@@ -40,14 +58,7 @@ TEST_F(VehicleClassesTest, EachClassStandsAsLongAndTallAsItsSize) {
                                     sim::VehicleClass::kBus, sim::VehicleClass::kMotorbike}) {
     const sim::VehicleLayout& layout = sim::vehicle_layout(c);
     sim::SceneState s = base;
-    const sim::TrackFrame f = track.at(s0 + 25.0 - 0.5 * layout.size_m.x - layout.rear_m);
-    sim::TrafficVehicle v;
-    v.id = 0;  // silver
-    v.vehicle_class = c;
-    v.size_m = layout.size_m;
-    const glm::dvec2 xy = glm::dvec2(f.position) + f.left * track.lane_centre(0);
-    v.state.position_m = {xy.x, xy.y, track.surface_height(s0 + 25.0, track.lane_centre(0))};
-    v.state.rotation.yaw_deg = glm::degrees(f.heading_rad);
+    const sim::TrafficVehicle v = in_lane(s, c, 0, 25.0, true);  // silver
     s.traffic = {v};
     s.traffic_lights = {sim::VehicleLights{}};
     const RgbaImage image = render(spec, s);
@@ -92,21 +103,12 @@ TEST_F(VehicleClassesTest, EachClassStandsAsLongAndTallAsItsSize) {
 // move) and leaves the body's as they were.
 TEST_F(VehicleClassesTest, EachModelsWheelsTurnAsItRolls) {
   const sim::SceneState base = dry_scene();
-  const sim::Track& track = sim::Track::built_in();
-  const double s0 = track.project(glm::dvec2(base.vehicle.position_m), 50.0).s;
   for (const sim::VehicleClass c : {sim::VehicleClass::kCar, sim::VehicleClass::kTruck,
                                     sim::VehicleClass::kBus, sim::VehicleClass::kMotorbike}) {
     const sim::VehicleLayout& layout = sim::vehicle_layout(c);
     sim::SceneState s = base;
     const double mid = 25.0;
-    const sim::TrackFrame f = track.at(s0 + mid - 0.5 * layout.size_m.x - layout.rear_m);
-    sim::TrafficVehicle v;
-    v.id = 4;  // dark red
-    v.vehicle_class = c;
-    v.size_m = layout.size_m;
-    const glm::dvec2 xy = glm::dvec2(f.position) + f.left * track.lane_centre(0);
-    v.state.position_m = {xy.x, xy.y, track.surface_height(s0 + mid, track.lane_centre(0))};
-    v.state.rotation.yaw_deg = glm::degrees(f.heading_rad);
+    const sim::TrafficVehicle v = in_lane(s, c, 4, mid, true);  // dark red
     s.traffic = {v};
     s.traffic_lights = {sim::VehicleLights{}};
     s.traffic_rolled_m = {0.0};
@@ -157,17 +159,8 @@ TEST_F(VehicleClassesTest, EachModelsWheelsTurnAsItRolls) {
 // the ego car's cabin, through write_glb and read_gltf, against the built-in path.
 TEST_F(VehicleClassesTest, AModelReadFromGltfDrawsAsTheBuiltInOne) {
   sim::SceneState s = dry_scene();
-  const sim::Track& track = sim::Track::built_in();
-  const double s0 = track.project(glm::dvec2(s.vehicle.position_m), 50.0).s;
   // 10 m ahead: near enough that the built-in truck is drawn in full, as a named model always is.
-  const sim::TrackFrame f = track.at(s0 + 10.0);
-  sim::TrafficVehicle v;
-  v.id = 2;
-  v.vehicle_class = sim::VehicleClass::kTruck;
-  v.size_m = sim::vehicle_layout(v.vehicle_class).size_m;
-  const glm::dvec2 xy = glm::dvec2(f.position) + f.left * track.lane_centre(0);
-  v.state.position_m = {xy.x, xy.y, track.surface_height(s0 + 10.0, track.lane_centre(0))};
-  v.state.rotation.yaw_deg = glm::degrees(f.heading_rad);
+  const sim::TrafficVehicle v = in_lane(s, sim::VehicleClass::kTruck, 2, 10.0, false);
   s.traffic = {v};
   s.traffic_lights = {sim::VehicleLights{}};
   const sim::ViewSpec spec = sim::view_spec(sim::View::kCockpit, kWidth, kHeight);
@@ -215,17 +208,7 @@ TEST_F(VehicleClassesTest, WheelsTurnAlikeInTheShaderAndDrawnOneByOne) {
   ASSERT_TRUE(ModelMesh(reordered).wheel_vertices.empty());
 
   sim::SceneState s = dry_scene();
-  const sim::Track& track = sim::Track::built_in();
-  const double s0 = track.project(glm::dvec2(s.vehicle.position_m), 50.0).s;
-  const sim::VehicleLayout& layout = sim::vehicle_layout(sim::VehicleClass::kCar);
-  const sim::TrackFrame f = track.at(s0 + 25.0 - 0.5 * layout.size_m.x - layout.rear_m);
-  sim::TrafficVehicle v;
-  v.id = 4;
-  v.vehicle_class = sim::VehicleClass::kCar;
-  v.size_m = layout.size_m;
-  const glm::dvec2 xy = glm::dvec2(f.position) + f.left * track.lane_centre(0);
-  v.state.position_m = {xy.x, xy.y, track.surface_height(s0 + 25.0, track.lane_centre(0))};
-  v.state.rotation.yaw_deg = glm::degrees(f.heading_rad);
+  const sim::TrafficVehicle v = in_lane(s, sim::VehicleClass::kCar, 4, 25.0, true);
   s.traffic = {v};
   s.traffic_lights = {sim::VehicleLights{}};
   s.traffic_rolled_m = {0.37};
@@ -262,16 +245,7 @@ TEST_F(VehicleClassesTest, WheelsTurnAlikeInTheShaderAndDrawnOneByOne) {
 // model is: a truck 90 m ahead, its pixels' mean colour from each model.
 TEST_F(VehicleClassesTest, AVehicleForTheDistanceIsShadedAsItsFullModel) {
   sim::SceneState s = dry_scene();
-  const sim::Track& track = sim::Track::built_in();
-  const double s0 = track.project(glm::dvec2(s.vehicle.position_m), 50.0).s;
-  const sim::TrackFrame f = track.at(s0 + 90.0);
-  sim::TrafficVehicle v;
-  v.id = 5;  // white
-  v.vehicle_class = sim::VehicleClass::kTruck;
-  v.size_m = sim::vehicle_layout(v.vehicle_class).size_m;
-  const glm::dvec2 xy = glm::dvec2(f.position) + f.left * track.lane_centre(0);
-  v.state.position_m = {xy.x, xy.y, track.surface_height(s0 + 90.0, track.lane_centre(0))};
-  v.state.rotation.yaw_deg = glm::degrees(f.heading_rad);
+  const sim::TrafficVehicle v = in_lane(s, sim::VehicleClass::kTruck, 5, 90.0, false);  // white
   const sim::ViewSpec spec = sim::view_spec(sim::View::kCockpit, 640, 360);
   const RgbaImage empty = render(spec, s);
   s.traffic = {v};
