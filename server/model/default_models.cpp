@@ -323,13 +323,17 @@ VehicleModel default_cabin(const sim::GlassConfig& glass) {
   render::MeshData m;
   const float dash_back = 1.45f, dash_top = bottom_left.z - 0.03f;
   // The dashboard's top, from the glass's foot back towards the driver, a little lower at the
-  // back; its face towards the driver, rounded into the top.
+  // back; its face towards the driver, and a bevel from the face up to the top (the view's bottom
+  // rows look down through where the two would otherwise leave a gap, at the road).
   m.add_face({dash_back + 0.04f, -0.85f, dash_top},
              {bottom_right.x, -0.85f, bottom_right.z - 0.005f},
              {bottom_left.x, 0.85f, bottom_left.z - 0.005f}, {dash_back + 0.04f, 0.85f, dash_top},
              material::kTrim);
   m.add_face({dash_back, 0.85f, 0.55f}, {dash_back, -0.85f, 0.55f},
              {dash_back, -0.85f, dash_top - 0.03f}, {dash_back, 0.85f, dash_top - 0.03f},
+             material::kTrim);
+  m.add_face({dash_back, 0.85f, dash_top - 0.03f}, {dash_back, -0.85f, dash_top - 0.03f},
+             {dash_back + 0.04f, -0.85f, dash_top}, {dash_back + 0.04f, 0.85f, dash_top},
              material::kTrim);
   // The instrument hood in front of the driver, rounded.
   add_rounded_box(m, {dash_back - 0.03f, 0.17f, 0.88f}, {1.78f, 0.57f, 1.03f}, 0.05f, kTrim,
