@@ -398,15 +398,17 @@ void mark_bonnet(VehicleModel& model, const sim::GlassConfig& glass, const glm::
   const float sight = std::tan(std::atan2(foot.z - eye.z, foot.x - eye.x) - 0.105f);
   auto ahead = [&](std::size_t t) {
     glm::vec3 normal(0.0f), centre(0.0f);
-    bool above = false, reaches = false, low = true;
+    bool above = false, reaches = false, behind = false, low = true;
     for (int k = 0; k < 3; ++k) {
       const render::MeshVertex& v = model.mesh.vertices[idx[t + k]];
       // Ahead of the foot; or reaching past it at the bonnet's height (the scuttle, the wings by
       // the glass), where a glass set further back than the model's leaves them in view.
-      if (v.position.x < ahead_of_x)
+      if (v.position.x < ahead_of_x) {
+        behind = true;
         low = low && v.position.z < foot.z + 0.05f;
-      else
+      } else {
         reaches = true;
+      }
       normal += v.normal;
       centre += v.position / 3.0f;
       above = above || v.position.z - eye.z > sight * (v.position.x - eye.x);
@@ -415,10 +417,7 @@ void mark_bonnet(VehicleModel& model, const sim::GlassConfig& glass, const glm::
     // smooth vertex normals turn further than the flat triangle does.
     const float facing = glm::dot(normal, eye - centre) /
                          std::max(glm::length(normal) * glm::length(eye - centre), 1e-6f);
-    bool whole = true;
-    for (int k = 0; k < 3; ++k)
-      whole = whole && model.mesh.vertices[idx[t + k]].position.x >= ahead_of_x;
-    return (whole || (reaches && low)) && above && facing > -0.35f &&
+    return (!behind || (reaches && low)) && above && facing > -0.35f &&
            model.mesh.vertices[idx[t]].uv.x != material::kGlass;
   };
   std::vector<std::uint32_t> first, rest;

@@ -145,11 +145,6 @@ Mesh::Mesh(const MeshData& data)
   }
 }
 
-void Mesh::draw() const {
-  glBindVertexArray(vao_.id());
-  glDrawElements(GL_TRIANGLES, index_count_, GL_UNSIGNED_INT, nullptr);
-}
-
 void Mesh::draw(std::uint32_t first_index, std::uint32_t count) const {
   if (count == 0) return;
   glBindVertexArray(vao_.id());

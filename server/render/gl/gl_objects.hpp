@@ -109,8 +109,7 @@ class Mesh {
  public:
   Mesh() = default;
   explicit Mesh(const MeshData& data);
-  void draw() const;
-  // Indices [first_index, first_index + count) alone.
+  // Indices [first_index, first_index + count).
   void draw(std::uint32_t first_index, std::uint32_t count) const;
   // Several index ranges in one call (glMultiDrawElements): counts[k] indices from byte offset
   // offsets[k] each.
