@@ -53,7 +53,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const VehicleModel again = read_gltf(write_glb(m), kind, limits);
   require(again.triangles() == m.triangles());
   require(again.wheels.size() == m.wheels.size());
-  if (kind == ModelKind::kVehicle) mark_bonnet(m, 2.0f);
+  if (kind == ModelKind::kVehicle) mark_bonnet(m);
   require(m.bonnet_index_count <= m.fixed_index_count);
   return 0;
 }
