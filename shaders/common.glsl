@@ -104,6 +104,17 @@ float schlick(float cos_theta, float r0) {
   return r0 + (1.0 - r0) * m2 * m2 * m;
 }
 
+// Fresnel's reflectance of unpolarized light on water (n = 1.333) from air, exact: Schlick's
+// approximation gives a tenth less between 50 and 70 degrees from the normal, where a road is seen
+// from a driver's or a chase camera's height, and more at grazing angles.
+float fresnel_water(float cos_theta) {
+  float c = clamp(cos_theta, 1e-4, 1.0);
+  float g = sqrt(0.7769 + c * c);  // sqrt(n^2 - 1 + c^2)
+  float a = (g - c) / (g + c);
+  float b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+  return 0.5 * a * a * (1.0 + b * b);
+}
+
 // Display transform: a gentle shoulder, then gamma 2 (sqrt: far cheaper than pow on llvmpipe).
 vec3 to_display(vec3 c) {
   c = c / (1.0 + 0.15 * c);

@@ -208,10 +208,13 @@ vec3 mirrored(vec3 p, vec3 r, vec3 sky, float streak) {
   if (c.w <= 1e-5) return sky;
   vec2 uv = c.xy / c.w * 0.5 + 0.5;
   vec2 inside = clamp(min(uv, 1.0 - uv) * 20.0, 0.0, 1.0);
-  // A streak on a film: two taps along the image's vertical, 3 texels of the mirror apart.
-  vec2 dv = vec2(0.0, 1.5 * streak / float(textureSize(reflection_tex, 0).y));
-  vec3 seen = from_display((textureLod(reflection_tex, uv - dv, 0.0).rgb +
-                            textureLod(reflection_tex, uv + dv, 0.0).rgb) * 0.5);
+  // A streak on a film: two taps along the image's vertical, a 60th of the view's height apart
+  // (half a degree either side in a 60-degree view): the film's slopes spread the mirror by an
+  // angle, the same at every size of the view. The taps are light, so they add in linear light
+  // (the mirror holds display values).
+  vec2 dv = vec2(0.0, streak / 120.0);
+  vec3 seen = (from_display(textureLod(reflection_tex, uv - dv, 0.0).rgb) +
+               from_display(textureLod(reflection_tex, uv + dv, 0.0).rgb)) * 0.5;
   return mix(sky, seen, inside.x * inside.y);
 }
 #endif
@@ -325,7 +328,7 @@ void main() {
 #endif
   float cos_v = dot(n_refl, view);
   vec3 r = reflect(-view, n_refl);
-  float fresnel = schlick(cos_v, 0.02);
+  float fresnel = fresnel_water(cos_v);
   // Gravel and grass off the pavement never mirror: a wet sheen at most. On the pavement the
   // mirror strengthens and sharpens as the water rises over the texture: streaked along the view
   // on a thin film (the texture's peaks still break it), clear once 1.2 mm stand over them (a

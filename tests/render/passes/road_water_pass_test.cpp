@@ -190,13 +190,15 @@ TEST_F(RoadWaterPassTest, AFloodedRoadMirrorsTheRedCarInRed) {
   for (int y = kHeight * 60 / 100; y < kHeight; y += kHeight / 20)
     std::printf("rows %d-%d: redness dry %.1f wet %.1f\n", y, y + kHeight / 20,
                 redness(dry_image, y, y + kHeight / 20), redness(wet_image, y, y + kHeight / 20));
-  // The mirror image of the car's rear: from 75% to 90% of the height. (Issue 30 asks for 6
-  // levels; the mirror gives 5.0 today, with the rounded car whose bumper curves under: this
-  // guards what holds.)
+  // The mirror image of the car's rear: from 75% to 90% of the height. Issue 30 asks for 6 levels;
+  // the water's exact Fresnel term (0.068 at this camera's 62 degrees, where Schlick's gives 0.061)
+  // and a streak as wide in angle at every size of the view bring it to 5.9-6.0 from 5.0. The
+  // rest is the car: its rear curves under, so the mirror sees its underside first. This guards
+  // what holds.
   const double gain = redness(wet_image, kHeight * 75 / 100, kHeight * 90 / 100) -
                       redness(dry_image, kHeight * 75 / 100, kHeight * 90 / 100);
-  std::printf("the mirror band's redness over the dry road's: %+.1f\n", gain);
-  EXPECT_GT(gain, 4.5);
+  std::printf("the mirror band's redness over the dry road's: %+.2f\n", gain);
+  EXPECT_GT(gain, 5.6);
 }
 
 // At night the flooded road mirrors the red car's tail lamps: below the car, in the band where the
