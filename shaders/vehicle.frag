@@ -10,6 +10,7 @@ uniform vec3 u_body_colour;
 // headlamps (a street light's lamp): 0 off, 1 on (low beam), 2 high beam.
 uniform vec4 u_lamps;
 uniform float u_head;
+uniform float u_wet;  // how wet the spray has made this body (0 dry to 1)
 // A lit lamp's lens as radiance: its luminance (cd/m^2) times the exposure, at least `floor`
 // (by day a lit lamp still stands out from its housing), at most `cap` (a camera's red channel
 // clips long before the others: a red lamp's core stays red).
@@ -48,9 +49,10 @@ void main() {
     float on = material == MATERIAL_INDICATOR_LEFT ? u_lamps.z : u_lamps.w;
     emit = lens(amber, 5000.0, 1.0, 3.0) * on;
   }
-  // Wet paint and trim (the weather's wetness): water in the finish's roughness deepens its colour,
-  // as on the wet ground, and a film of it makes the sheen a mirror.
-  float wet = frame.wetness * float(material == MATERIAL_BODY || material == MATERIAL_TRIM);
+  // Wet paint and trim (the weather's wetness, or the spray's that this body stopped): water in
+  // the finish's roughness deepens its colour, as on the wet ground, and a film of it makes the
+  // sheen a mirror.
+  float wet = max(frame.wetness, u_wet) * float(material == MATERIAL_BODY || material == MATERIAL_TRIM);
   albedo *= mix(1.0, 0.72, wet);
   gloss = mix(gloss, 1.0, wet);
   r0 = mix(r0, 0.05, wet);

@@ -74,6 +74,18 @@ void Simulation::publish() {
   }
   state_.ego_place = ego_place(surface_->roads(), glm::dvec2(state_.vehicle.position_m));
   roll(state_);
+  wet_bodies(state_);
+}
+
+// The spray's keys: the ego car's 0, each traffic vehicle's its id + 1 (spray_step()).
+void Simulation::wet_bodies(SceneState& scene) const {
+  scene.ego_body_wet = static_cast<float>(spray_.body_wetness(0, spray_ego_size()));
+  scene.traffic_body_wet.resize(scene.traffic.size());
+  for (std::size_t i = 0; i < scene.traffic.size(); ++i) {
+    const TrafficVehicle& other = scene.traffic[i];
+    scene.traffic_body_wet[i] = static_cast<float>(
+        spray_.body_wetness(other.id == UINT32_MAX ? other.id : other.id + 1, other.size_m));
+  }
 }
 
 void Simulation::roll(SceneState& scene) const {
@@ -152,6 +164,11 @@ bool Simulation::whole_sub_step_due(double carry_s) const {
   return carry_s >= config_.sub_step_s * (1.0 - 1e-9);
 }
 
+// (The spray's car is 4.5 m of the 4.6: its hull, bumpers aside.)
+glm::dvec3 Simulation::spray_ego_size() const {
+  return config_.ego.size_m * glm::dvec3(4.5 / 4.6, 1.0, 1.0);
+}
+
 SceneState Simulation::inputs_after(double dt_s) const {
   SceneState inputs;
   inputs.client_time_s = state_.client_time_s;
@@ -176,6 +193,7 @@ SceneState Simulation::inputs_after(double dt_s) const {
     ++inputs.sub_steps;
   inputs.sim_time_s = static_cast<double>(inputs.sub_steps) * config_.sub_step_s;
   roll(inputs);
+  wet_bodies(inputs);
   return inputs;
 }
 
@@ -235,8 +253,7 @@ void Simulation::spray_step() {
     s.state.position_m += state.velocity_mps * ahead;
     sources.push_back(s);
   };
-  // (The spray's car is 4.5 m of the 4.6: its hull, bumpers aside.)
-  add(0, state_.vehicle, config_.ego.size_m * glm::dvec3(4.5 / 4.6, 1.0, 1.0), VehicleClass::kCar);
+  add(0, state_.vehicle, spray_ego_size(), VehicleClass::kCar);
   for (const TrafficVehicle& other : state_.traffic)
     add(other.id == UINT32_MAX ? other.id : other.id + 1, other.state, other.size_m,
         other.vehicle_class);

@@ -73,6 +73,10 @@ struct SceneState {
   // radius. The ego car's, and the traffic's in the order of `traffic`.
   double ego_rolled_m = 0.0;
   std::vector<double> traffic_rolled_m;
+  // How wet the spray has made each vehicle's body (0 dry to 1; the weather's rain wets it too,
+  // as it does the ground): the ego car's, and the traffic's in the order of `traffic`.
+  float ego_body_wet = 0.0f;
+  std::vector<float> traffic_body_wet;
   // The roads the session drives on (road_network.hpp): the built-in track's unless the session
   // brought its own.
   std::shared_ptr<const RoadNetwork> roads;
@@ -115,7 +119,9 @@ class Simulation {
   VehicleMotion ego_motion_;
   std::unordered_map<std::uint32_t, VehicleMotion> traffic_motion_;
   void resolve_lights(bool vehicle_moved, bool traffic_moved);
-  void roll(SceneState& scene) const;  // its *_rolled_m at its sim_time_s
+  void roll(SceneState& scene) const;        // its *_rolled_m at its sim_time_s
+  void wet_bodies(SceneState& scene) const;  // its *_body_wet from the spray
+  glm::dvec3 spray_ego_size() const;         // the ego car as a spray source
   std::uint64_t seed_;
   double carry_s_ = 0.0;
   WiperMotion wipers_;

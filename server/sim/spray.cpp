@@ -214,6 +214,103 @@ void Spray::emit(const Pose& v, SprayGround& ground) {
   }
 }
 
+namespace {
+constexpr double kGridCell_m = 8.0;
+constexpr int kGridSide = 64;  // cells: 512 m, the ego car's range of 250 m either way
+constexpr std::size_t kMaxWetBodies = 1024;
+}  // namespace
+
+void Spray::find_targets(const std::vector<SpraySource>& sources, std::size_t first) {
+  targets_.clear();
+  grid_target_.clear();
+  grid_next_.clear();
+  grid_head_.assign(static_cast<std::size_t>(kGridSide) * kGridSide, -1);
+  if (sources.empty()) return;
+  grid_origin_ = glm::dvec2(sources[0].state.position_m) - 0.5 * kGridSide * kGridCell_m;
+  for (std::size_t i = first; i < sources.size() && targets_.size() < 4096; ++i) {
+    const SpraySource& s = sources[i];
+    const VehicleLayout& layout = vehicle_layout(s.vehicle_class);
+    const glm::dvec3 size = glm::max(s.size_m, glm::dvec3(0.5));
+    const double rear = layout.rear_m * size.x / layout.size_m.x;
+    const glm::dmat3 rotation = rotation_matrix(s.state.rotation);
+    if (rotation[2].z < 0.5) continue;  // not on its wheels
+    Target t{s.key,
+             s.state.position_m,
+             glm::transpose(rotation),
+             {rear, -0.5 * size.y, 0.1},
+             {rear + size.x, 0.5 * size.y, size.z},
+             0.0};
+    // Its cells: those its footprint's circle touches.
+    const glm::dvec3 centre = s.state.position_m + rotation * (0.5 * (t.lo + t.hi));
+    const double reach = 0.5 * std::hypot(size.x, size.y);
+    const glm::dvec2 lo = (glm::dvec2(centre) - reach - grid_origin_) / kGridCell_m;
+    const glm::dvec2 hi = (glm::dvec2(centre) + reach - grid_origin_) / kGridCell_m;
+    if (hi.x < 0.0 || hi.y < 0.0 || lo.x >= kGridSide || lo.y >= kGridSide) continue;
+    const auto index = static_cast<std::int16_t>(targets_.size());
+    targets_.push_back(t);
+    for (int y = std::max(0, static_cast<int>(lo.y));
+         y <= std::min(kGridSide - 1, static_cast<int>(hi.y)); ++y) {
+      for (int x = std::max(0, static_cast<int>(lo.x));
+           x <= std::min(kGridSide - 1, static_cast<int>(hi.x)); ++x) {
+        std::int16_t& head = grid_head_[static_cast<std::size_t>(y) * kGridSide + x];
+        grid_target_.push_back(index);
+        grid_next_.push_back(head);
+        head = static_cast<std::int16_t>(grid_target_.size() - 1);
+      }
+    }
+  }
+}
+
+Spray::Target* Spray::target_at(glm::dvec3 p, std::uint32_t source) {
+  const glm::dvec2 g = (glm::dvec2(p) - grid_origin_) / kGridCell_m;
+  if (!(g.x >= 0.0 && g.y >= 0.0 && g.x < kGridSide && g.y < kGridSide)) return nullptr;
+  const std::size_t cell =
+      static_cast<std::size_t>(static_cast<int>(g.y)) * kGridSide + static_cast<int>(g.x);
+  for (std::int16_t e = grid_head_[cell]; e >= 0; e = grid_next_[static_cast<std::size_t>(e)]) {
+    Target& t = targets_[static_cast<std::size_t>(grid_target_[static_cast<std::size_t>(e)])];
+    if (t.key == source) continue;
+    const glm::dvec3 q = t.to_vehicle * (p - t.position);
+    if (q.x > t.lo.x && q.x < t.hi.x && q.y > t.lo.y && q.y < t.hi.y && q.z > t.lo.z &&
+        q.z < t.hi.z)
+      return &t;
+  }
+  return nullptr;
+}
+
+// Each body's water: what it held, run off and dried over the step, and what it caught.
+void Spray::wet_bodies() {
+  const double keep = std::exp(-config_.step_s / config_.body_dry_s);
+  for (auto& [key, water] : body_water_) water *= keep;
+  for (const Target& t : targets_) {
+    if (t.wet_m3 <= 0.0) continue;
+    const auto it =
+        std::lower_bound(body_water_.begin(), body_water_.end(), std::make_pair(t.key, 0.0),
+                         [](const auto& a, const auto& b) { return a.first < b.first; });
+    if (it != body_water_.end() && it->first == t.key)
+      it->second += t.wet_m3;
+    else
+      body_water_.insert(it, {t.key, t.wet_m3});
+  }
+  // A microlitre is dry. Bounded: past kMaxWetBodies, the driest go.
+  std::erase_if(body_water_, [](const auto& b) { return b.second < 1e-9; });
+  if (body_water_.size() > kMaxWetBodies) {
+    std::vector<double> water;
+    for (const auto& b : body_water_) water.push_back(b.second);
+    std::nth_element(water.begin(), water.end() - kMaxWetBodies, water.end());
+    const double least = water[water.size() - kMaxWetBodies];
+    std::erase_if(body_water_, [least](const auto& b) { return b.second < least; });
+  }
+}
+
+double Spray::body_wetness(std::uint32_t key, glm::dvec3 size_m) const {
+  const auto it = std::lower_bound(body_water_.begin(), body_water_.end(), std::make_pair(key, 0.0),
+                                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  if (it == body_water_.end() || it->first != key) return 0.0;
+  const glm::dvec3 s = glm::max(size_m, glm::dvec3(0.5));
+  const double area = 2.0 * (s.x * s.y + s.x * s.z + s.y * s.z);
+  return std::min(it->second / (area * config_.wet_film_mm * 1e-3), 1.0);
+}
+
 void Spray::step(const std::vector<SpraySource>& sources, glm::dvec3 wind, SprayGround& ground,
                  const GlassConfig* glass, const GlassHit& glass_hit) {
   const SprayConfig& c = config_;
@@ -242,6 +339,8 @@ void Spray::step(const std::vector<SpraySource>& sources, glm::dvec3 wind, Spray
     p.rear_x = rear * size.x / layout.size_m.x;
     poses.push_back(p);
   }
+  // The ego car's glass and hull stop spray below when the glass is given; else its box does.
+  find_targets(sources, glass && !sources.empty() ? 1 : 0);
   std::vector<std::pair<std::uint32_t, std::size_t>> by_key;
   for (std::size_t i = 0; i < poses.size(); ++i) by_key.emplace_back(poses[i].key, i);
   std::sort(by_key.begin(), by_key.end());
@@ -255,6 +354,7 @@ void Spray::step(const std::vector<SpraySource>& sources, glm::dvec3 wind, Spray
   const glm::dvec3 ego_before = ego ? ego->position - ego->velocity * dt : glm::dvec3(0.0);
   const glm::dvec3 glass_normal = glass ? glass->normal() : glm::dvec3(0.0);
 
+  double ego_caught = 0.0;
   const glm::dvec3 gravity(0.0, 0.0, -kGravity);
   const double eddy_keep = std::exp(-dt / c.eddy_s);
   std::size_t kept = 0;
@@ -319,7 +419,15 @@ void Spray::step(const std::vector<SpraySource>& sources, glm::dvec3 wind, Spray
         if (!gone && p.source != ego->key && (in_hull || in_cabin)) {
           gone = true;
           ledger_.on_body_m3 += p.volume_m3;
+          ego_caught += p.volume_m3;
         }
+      }
+    }
+    if (!gone) {
+      if (Target* hit = target_at(p.position_m, p.source)) {
+        gone = true;
+        ledger_.on_body_m3 += p.volume_m3;
+        hit->wet_m3 += p.volume_m3;
       }
     }
     const Pose* plane = from ? from : (poses.empty() ? nullptr : &poses[0]);
@@ -343,6 +451,8 @@ void Spray::step(const std::vector<SpraySource>& sources, glm::dvec3 wind, Spray
     if (!gone) particles_[kept++] = p;
   }
   particles_.resize(kept);
+  if (ego) targets_.push_back({ego->key, {}, {}, {}, {}, ego_caught});
+  wet_bodies();
 
   // Vehicles far from the ego car throw nothing (their parcels would be let go by range), nor do
   // those not on their wheels.

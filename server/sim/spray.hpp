@@ -44,6 +44,7 @@
 #include <memory>
 #include <vector>
 
+#include <glm/mat3x3.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
@@ -109,6 +110,11 @@ struct SprayConfig {
   // Body or spray (seed 001): a liquid parcel with this many others this near is in a body.
   double neighbour_radius_m = 0.2;
   int body_neighbours = 8;
+  // A vehicle's body stops the spray that meets it (all but its own) and gets wet: the water it
+  // caught wets it fully as a film of wet_film_mm over its whole surface, and runs off and dries
+  // with this time constant.
+  double wet_film_mm = 0.02;
+  double body_dry_s = 40.0;
 };
 
 // What throws spray: the ego car (key 0) and each traffic vehicle (key id + 1), posed as in the
@@ -174,7 +180,7 @@ struct SprayLedger {
   double returned_m3 = 0.0;   // large droplets that landed back in a cell
   double landed_m3 = 0.0;     // smaller droplets that landed (and large ones off the windows)
   double on_glass_m3 = 0.0;   // left on the ego car's windshield
-  double on_body_m3 = 0.0;    // on the rest of the ego car
+  double on_body_m3 = 0.0;    // on a vehicle's body: the rest of the ego car, the traffic
   double dispersed_m3 = 0.0;  // mist that expired, and what flowed around the glass
   double dropped_m3 = 0.0;    // parcels let go: the budget, their age, their range
 };
@@ -213,6 +219,9 @@ class Spray {
 
   const std::vector<SprayParticle>& particles() const { return particles_; }
   const SprayLedger& ledger() const { return ledger_; }
+  // How wet the spray has made the body of the vehicle with this key (0 dry to 1), its size as
+  // its source gave it.
+  double body_wetness(std::uint32_t key, glm::dvec3 size_m) const;
   double airborne_m3() const;
   const SprayConfig& config() const { return config_; }
   void image(glm::dvec3 origin_m, SprayImage& out) const;
@@ -238,7 +247,26 @@ class Spray {
   static constexpr double kDragSpeedStep = 0.25;
   Drag drag_at(int kind, double speed) const;
 
+  // The bodies that stop spray this step, and a grid over the ego car's range that finds them.
+  struct Target {
+    std::uint32_t key;
+    glm::dvec3 position;
+    glm::dmat3 to_vehicle;  // world to vehicle
+    glm::dvec3 lo, hi;      // its box in its own frame
+    double wet_m3;          // what it caught this step
+  };
+  void find_targets(const std::vector<SpraySource>& sources, std::size_t first);
+  Target* target_at(glm::dvec3 p, std::uint32_t source);
+  void wet_bodies();
+
   SprayConfig config_;
+  std::vector<Target> targets_;
+  glm::dvec2 grid_origin_{0.0};
+  std::vector<std::int16_t> grid_head_;    // per cell, its first entry (-1: none)
+  std::vector<std::int16_t> grid_target_;  // per entry, its target and the next entry in its cell
+  std::vector<std::int16_t> grid_next_;
+  // Each body's caught water (m^3) by key, sorted.
+  std::vector<std::pair<std::uint32_t, double>> body_water_;
   std::array<std::array<Drag, kDragSteps + 1>, kSprayKinds> drag_{};
   RandomStream random_;
   std::vector<SprayParticle> particles_;  // oldest first

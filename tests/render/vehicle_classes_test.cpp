@@ -309,6 +309,57 @@ TEST_F(VehicleClassesTest, TheBonnetFollowsTheSessionsGlass) {
   EXPECT_GT(red(back), red(usual) * 9 / 10);
 }
 
+// The spray a body stops wets it (sim/spray.hpp), on a dry day too: a silver car 25 m ahead whose
+// body the spray has wet through, and the ego car's bonnet likewise, darken as wet paint does.
+// (SprayTest.AVehicleStopsTheSprayThatMeetsItAndGetsWet: how the spray wets them.)
+TEST_F(VehicleClassesTest, TheSprayABodyStoppedWetsIt) {
+  sim::SceneState s = dry_scene();
+  s.weather.rain_rate_mm_h = 0.0;  // a dry day: the weather wets nothing
+  const sim::ViewSpec spec = sim::view_spec(sim::View::kCockpit, 640, 360);
+  const RgbaImage empty = render(spec, s);
+  s.traffic = {in_lane(s, sim::VehicleClass::kCar, 0, 25.0, true)};  // silver
+  s.traffic_lights = {sim::VehicleLights{}};
+  s.traffic_body_wet = {0.0f};
+  const RgbaImage dry = render(spec, s);
+  s.traffic_body_wet = {1.0f};
+  s.ego_body_wet = 1.0f;
+  const RgbaImage wet = render(spec, s);
+  if (const char* dir = std::getenv("DOWNPOUR_TEST_IMAGES")) {
+    testing::write_png(std::string(dir) + "/body_dry.png", dry);
+    testing::write_png(std::string(dir) + "/body_wet.png", wet);
+  }
+  // The car: the pixels it covers (against the empty road), their mean luma dry and wet. The
+  // bonnet: the mean red of the red pixels in the view's third quarter from the top.
+  double car[2] = {0.0, 0.0}, bonnet[2] = {0.0, 0.0};
+  int n_car = 0, n_bonnet = 0;
+  for (std::size_t i = 0; i < dry.pixels.size(); i += 4) {
+    const std::uint8_t* d = &dry.pixels[i];
+    int change = 0;
+    for (int k = 0; k < 3; ++k) change = std::max(change, std::abs(d[k] - empty.pixels[i + k]));
+    if (change > 12) {
+      car[0] += 0.3 * d[0] + 0.59 * d[1] + 0.11 * d[2];
+      car[1] += 0.3 * wet.pixels[i] + 0.59 * wet.pixels[i + 1] + 0.11 * wet.pixels[i + 2];
+      ++n_car;
+    }
+    const std::size_t row = i / 4 / static_cast<std::size_t>(spec.width);
+    const bool low = row > static_cast<std::size_t>(spec.height / 2) &&
+                     row < static_cast<std::size_t>(spec.height * 3 / 4);
+    if (change == 0 && low && d[0] > d[1] + 8 && d[0] > d[2] + 8) {
+      bonnet[0] += d[0], bonnet[1] += wet.pixels[i], ++n_bonnet;
+    }
+  }
+  ASSERT_GT(n_car, 200);
+  ASSERT_GT(n_bonnet, 1000);
+  std::printf(
+      "the car ahead: mean luma %.1f dry, %.1f wet (%d px); the bonnet's red %.1f dry, "
+      "%.1f wet (%d px)\n",
+      car[0] / n_car, car[1] / n_car, n_car, bonnet[0] / n_bonnet, bonnet[1] / n_bonnet, n_bonnet);
+  // Wet paint darkens (albedo x0.72) and mirrors the bright overcast more (vehicle.frag): 5-6% in
+  // all, windows and lamps included; unwetted, both stay as they are.
+  EXPECT_LT(car[1], car[0] * 0.97);
+  EXPECT_LT(bonnet[1], bonnet[0] * 0.97);
+}
+
 // The changed pixels' columns (x0, x1) and rows (y0, y1) of an image against another.
 glm::ivec4 changed_box(const RgbaImage& image, const RgbaImage& base) {
   glm::ivec4 box(image.width, -1, image.height, -1);

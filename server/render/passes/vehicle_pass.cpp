@@ -16,7 +16,8 @@ VehiclePass::VehiclePass(SharedResources&)
       uniforms_(program_),
       u_body_colour_(program_.uniform("u_body_colour")),
       u_lamps_(program_.uniform("u_lamps")),
-      u_head_(program_.uniform("u_head")) {
+      u_head_(program_.uniform("u_head")),
+      u_wet_(program_.uniform("u_wet")) {
   for (const sim::VehicleClass c : {sim::VehicleClass::kCar, sim::VehicleClass::kTruck,
                                     sim::VehicleClass::kBus, sim::VehicleClass::kMotorbike}) {
     near_.emplace_back(model::default_vehicle(c, model::Detail::kFull));
@@ -24,9 +25,10 @@ VehiclePass::VehiclePass(SharedResources&)
   }
 }
 
-void VehiclePass::prepare(const glm::vec3& colour, const sim::VehicleLights& lights,
-                          bool flash_on) {
+void VehiclePass::prepare(const glm::vec3& colour, const sim::VehicleLights& lights, bool flash_on,
+                          float body_wet) {
   u_body_colour_.set(colour);
+  u_wet_.set(body_wet);
   const bool heads =
       lights.headlights == sim::Headlights::kLow || lights.headlights == sim::Headlights::kHigh;
   const float flash = flash_on ? 1.0f : 0.0f;
@@ -48,7 +50,8 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
   const sim::ModelPtr& ego_model = frame.scene.ego.body_model;
   const glm::vec3 made = ego_model ? ego_model->size() : glm::vec3(sim::EgoGeometry{}.size_m);
   const glm::vec3 ego_scale = cockpit ? glm::vec3(1.0f) : glm::vec3(frame.scene.ego.size_m) / made;
-  prepare(glm::vec3(0.42f, 0.05f, 0.04f), shown_lights(frame.scene.ego_lights, weather), flash_on);
+  prepare(glm::vec3(0.42f, 0.05f, 0.04f), shown_lights(frame.scene.ego_lights, weather), flash_on,
+          frame.scene.ego_body_wet);
   const auto car = static_cast<std::size_t>(sim::VehicleClass::kCar);
   const ModelMesh* ego = ego_model ? &named_.get(ego_model) : &near_[car];
   const sim::GlassConfig& glass = frame.scene.glass;
@@ -89,7 +92,9 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
     const sim::VehicleLights lights = i < frame.scene.traffic_lights.size()
                                           ? frame.scene.traffic_lights[i]
                                           : sim::VehicleLights{};
-    prepare(palette[other.id % 6], shown_lights(lights, weather), flash_on);
+    const float body_wet =
+        i < frame.scene.traffic_body_wet.size() ? frame.scene.traffic_body_wet[i] : 0.0f;
+    prepare(palette[other.id % 6], shown_lights(lights, weather), flash_on, body_wet);
     const double rolled =
         i < frame.scene.traffic_rolled_m.size() ? frame.scene.traffic_rolled_m[i] : 0.0;
     const float distance = glm::length(centre - frame.camera.position);

@@ -19,8 +19,9 @@ class VehiclePass final : public Pass {
   void execute(const FrameContext& frame, const FrameResources& resources) override;
 
  private:
-  // Sets a vehicle's colour and lamps for the meshes drawn next.
-  void prepare(const glm::vec3& colour, const sim::VehicleLights& lights, bool flash_on);
+  // Sets a vehicle's colour, lamps and how wet the spray made it for the meshes drawn next.
+  void prepare(const glm::vec3& colour, const sim::VehicleLights& lights, bool flash_on,
+               float body_wet);
 
   const PassDecl decl_{"vehicles",
                        {Resource::kLampMap},
@@ -28,7 +29,7 @@ class VehiclePass final : public Pass {
                        {DepthTest::kNearer, true, Blend::kOff}};
   ShaderProgram program_;
   ModelUniforms uniforms_;
-  Uniform u_body_colour_, u_lamps_, u_head_;
+  Uniform u_body_colour_, u_lamps_, u_head_, u_wet_;
   // Each class's built-in model in full and for the distance (default_models.hpp's Detail): by
   // class. The models sessions name, as their scenes hold them.
   std::vector<ModelMesh> near_, far_;

@@ -7,15 +7,18 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
 
+#include "server/sim/pose.hpp"
 #include "server/sim/road_surface.hpp"
 #include "server/sim/road_water.hpp"
 #include "server/sim/simulation.hpp"
 #include "server/sim/track.hpp"
+#include "server/sim/vehicle_class.hpp"
 #include "tests/support/spray_drive.hpp"
 
 namespace downpour::sim {
@@ -297,6 +300,70 @@ TEST(SprayTest, FollowingATruckWetsTheGlass) {
   const auto [following, following_ml] = glass(true);
   EXPECT_GT(following_ml, 0.0);
   EXPECT_GT(following, alone + 0.02);
+}
+
+// A car 20 m behind a truck at 25 m/s on a drenched road: the truck's spray that meets the car
+// stops there (none of it is left inside its body, where parcels pass when it is not there) and
+// wets it;
+// the truck, which meets none, stays dry.
+TEST(SprayTest, AVehicleStopsTheSprayThatMeetsItAndGetsWet) {
+  constexpr double kGap = 20.0;
+  const glm::dvec3 car(4.5, 1.8, 1.47);
+  auto run = [&](bool with_car, double seconds) {
+    EvenGround ground(kDrenchM);
+    Drive drive;
+    drive.add(1, 300.0, 25.0, kTruck);
+    if (with_car) drive.add(2, 300.0 - kGap, 25.0, car);
+    drive.run(seconds, ground);
+    // Parcels within the car's body (where it is, or would be): its box in its own frame.
+    const VehicleState at = on_track(300.0 - kGap + 25.0 * seconds, 25.0);
+    const glm::dmat3 to_car = glm::transpose(rotation_matrix(at.rotation));
+    const VehicleLayout& layout = vehicle_layout(VehicleClass::kCar);
+    int inside = 0;
+    for (const SprayParticle& p : drive.spray.particles()) {
+      if (p.source == 2) continue;  // its own front wheels' spray passes under its wings
+      const glm::dvec3 q = to_car * (p.position_m - at.position_m);
+      inside += q.x > layout.rear_m + 0.3 && q.x < layout.rear_m + car.x - 0.3 &&
+                std::abs(q.y) < 0.5 * car.y - 0.2 && q.z > 0.3 && q.z < car.z - 0.2;
+    }
+    return std::make_tuple(inside, drive.spray.body_wetness(2, car),
+                           drive.spray.body_wetness(1, kTruck), drive.spray.ledger().on_body_m3);
+  };
+  const auto [passing, no_car, no_car_truck, no_car_ml] = run(false, 3.0);
+  const auto [stopped, wet, truck_wet, caught_m3] = run(true, 3.0);
+  const auto [early_stopped, early_wet, early_truck, early_m3] = run(true, 0.5);
+  std::printf(
+      "parcels in the car's place: %d without it, %d with it; its body caught %.1f ml, wet %.2f "
+      "after 3 s (%.2f after 0.5 s); the truck wet %.2f\n",
+      passing, stopped, caught_m3 * 1e6, wet, early_wet, truck_wet);
+  EXPECT_GT(passing, 20);
+  EXPECT_EQ(stopped, 0);
+  EXPECT_EQ(no_car, 0.0);
+  EXPECT_GT(wet, 0.8);
+  EXPECT_LT(early_wet, wet);
+  EXPECT_EQ(truck_wet, 0.0);
+}
+
+// What a body caught runs off and dries once the spray stops: with no spray, a wet body's water
+// keeps exp(-t / body_dry_s) of itself.
+TEST(SprayTest, AWetBodyDries) {
+  EvenGround drenched(kDrenchM), dry(0.0);
+  SprayConfig config;
+  config.wet_film_mm *= 10.0;  // (so that it is not wet through, where its wetness stops at 1)
+  Drive drive(7, config);
+  drive.add(1, 300.0, 25.0, kTruck);
+  drive.add(2, 280.0, 25.0);
+  drive.run(3.0, drenched);
+  const glm::dvec3 car(4.5, 1.8, 1.47);
+  drive.run(3.0, dry);  // the last of the spray settles
+  const double before = drive.spray.body_wetness(2, car);
+  const double seconds = 0.5 * drive.spray.config().body_dry_s;
+  drive.run(seconds, dry);
+  const double after = drive.spray.body_wetness(2, car);
+  std::printf("wet %.3f, then %.3f after %.0f s without spray\n", before, after, seconds);
+  ASSERT_GT(before, 0.0);
+  ASSERT_LT(before, 1.0);
+  EXPECT_NEAR(after / before, std::exp(-0.5), 0.01);
 }
 
 }  // namespace
