@@ -27,6 +27,7 @@
 #include "server/render/passes/rain_pass.hpp"
 #include "server/render/passes/road_pass.hpp"
 #include "server/render/passes/road_reflection_pass.hpp"
+#include "server/render/passes/spray_mirror_pass.hpp"
 #include "server/render/passes/spray_pass.hpp"
 #include "server/render/render_session.hpp"
 #include "server/render/render_targets.hpp"
@@ -337,6 +338,7 @@ void Renderer::set_spray_smoothing(SpraySmoothing smoothing) {
 SpraySmoothing Renderer::spray_smoothing() const { return impl_->passes.spray_smooth->smoothing(); }
 void Renderer::set_relief_shadows(bool on) { impl_->passes.road->set_relief_shadows(on); }
 void Renderer::set_lamps(bool on) { impl_->lamps_on = on; }
+void Renderer::set_spray_in_mirror(bool on) { impl_->passes.spray_mirror->set_on(on); }
 bool Renderer::last_drew_relief() const { return impl_->view_drew_relief; }
 void Renderer::set_spray_cpu_splat(bool cpu) { impl_->passes.spray->set_cpu_splat(cpu); }
 bool Renderer::spray_cpu_splat() const { return impl_->passes.spray->cpu_splat(); }

@@ -96,6 +96,9 @@ class Renderer {
   // Whether frames light the scene with their lamps (on by default; off for the lights' benchmark:
   // no lamp map, no lamp in the shaders' loops or the rain; the lit lenses still glow).
   void set_lamps(bool on);
+  // Whether the road's mirror shows the spray's clouds (on by default; off for the tests that
+  // compare).
+  void set_spray_in_mirror(bool on);
   // Whether the CPU draws the spray's parcels (llvmpipe's choice) or the GPU.
   void set_spray_cpu_splat(bool cpu);
   bool spray_cpu_splat() const;

@@ -15,6 +15,7 @@
 #include "server/render/passes/road_pass.hpp"
 #include "server/render/passes/road_reflection_pass.hpp"
 #include "server/render/passes/sky_pass.hpp"
+#include "server/render/passes/spray_mirror_pass.hpp"
 #include "server/render/passes/spray_pass.hpp"
 #include "server/render/passes/street_light_pass.hpp"
 #include "server/render/passes/terrain_pass.hpp"
@@ -60,10 +61,14 @@ ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
                                     own(std::make_unique<SprayCompositePass>(shared, *p.spray))};
   p.water = {rain, spray.front(), glass_water_mask, glass_water, glass_composite};
   p.lamp_map = own(std::make_unique<LampMapPass>(lamps));
+  p.spray_mirror = own(std::make_unique<SprayMirrorPass>(shared));
   // What the road's mirror shows, each clipped this far above the road's plane.
   p.reflection = own(std::make_unique<RoadReflectionPass>(
-      block, std::vector<RoadReflectionPass::Reflected>{
-                 {vehicles, -0.02f}, {street_lights, 0.0f}, {terrain, 0.5f}, {sky, 0.0f}}));
+      block, std::vector<RoadReflectionPass::Reflected>{{vehicles, -0.02f},
+                                                        {street_lights, 0.0f},
+                                                        {terrain, 0.5f},
+                                                        {sky, 0.0f},
+                                                        {p.spray_mirror, 0.0f}}));
 
   auto& views = p.views;
   auto& frame = p.frame;

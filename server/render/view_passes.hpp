@@ -21,6 +21,7 @@ class RainPass;
 class RoadPass;
 class RoadReflectionPass;
 class SprayPass;
+class SprayMirrorPass;
 class SpraySmoothPass;
 
 struct ViewPasses {
@@ -44,6 +45,7 @@ struct ViewPasses {
   GlassCompositePass* glass_composite = nullptr;
   LampMapPass* lamp_map = nullptr;
   RoadReflectionPass* reflection = nullptr;
+  SprayMirrorPass* spray_mirror = nullptr;
   RoadPass* road = nullptr;
   RainPass* rain = nullptr;
   SprayPass* spray = nullptr;

@@ -234,15 +234,18 @@ void Spray::find_targets(const std::vector<SpraySource>& sources, std::size_t fi
     const double rear = layout.rear_m * size.x / layout.size_m.x;
     const glm::dmat3 rotation = rotation_matrix(s.state.rotation);
     if (rotation[2].z < 0.5) continue;  // not on its wheels
-    Target t{s.key,
-             s.state.position_m,
-             glm::transpose(rotation),
-             {rear, -0.5 * size.y, 0.1},
-             {rear + size.x, 0.5 * size.y, size.z},
-             0.0};
-    // Its cells: those its footprint's circle touches.
-    const glm::dvec3 centre = s.state.position_m + rotation * (0.5 * (t.lo + t.hi));
+    const glm::dvec3 box_lo(rear, -0.5 * size.y, 0.1), box_hi(rear + size.x, 0.5 * size.y, size.z);
+    const glm::dvec3 centre = s.state.position_m + rotation * (0.5 * (box_lo + box_hi));
     const double reach = 0.5 * std::hypot(size.x, size.y);
+    const Target t{s.key,
+                   glm::dvec2(centre),
+                   reach * reach,
+                   s.state.position_m,
+                   glm::transpose(rotation),
+                   box_lo,
+                   box_hi,
+                   0.0};
+    // Its cells: those its footprint's circle touches.
     const glm::dvec2 lo = (glm::dvec2(centre) - reach - grid_origin_) / kGridCell_m;
     const glm::dvec2 hi = (glm::dvec2(centre) + reach - grid_origin_) / kGridCell_m;
     if (hi.x < 0.0 || hi.y < 0.0 || lo.x >= kGridSide || lo.y >= kGridSide) continue;
@@ -269,6 +272,8 @@ Spray::Target* Spray::target_at(glm::dvec3 p, std::uint32_t source) {
   for (std::int16_t e = grid_head_[cell]; e >= 0; e = grid_next_[static_cast<std::size_t>(e)]) {
     Target& t = targets_[static_cast<std::size_t>(grid_target_[static_cast<std::size_t>(e)])];
     if (t.key == source) continue;
+    const glm::dvec2 d = glm::dvec2(p) - t.centre;
+    if (d.x * d.x + d.y * d.y > t.reach2) continue;
     const glm::dvec3 q = t.to_vehicle * (p - t.position);
     if (q.x > t.lo.x && q.x < t.hi.x && q.y > t.lo.y && q.y < t.hi.y && q.z > t.lo.z &&
         q.z < t.hi.z)
@@ -451,7 +456,7 @@ void Spray::step(const std::vector<SpraySource>& sources, glm::dvec3 wind, Spray
     if (!gone) particles_[kept++] = p;
   }
   particles_.resize(kept);
-  if (ego) targets_.push_back({ego->key, {}, {}, {}, {}, ego_caught});
+  if (ego) targets_.push_back({ego->key, {}, 0.0, {}, {}, {}, {}, ego_caught});
   wet_bodies();
 
   // Vehicles far from the ego car throw nothing (their parcels would be let go by range), nor do

@@ -250,6 +250,8 @@ class Spray {
   // The bodies that stop spray this step, and a grid over the ego car's range that finds them.
   struct Target {
     std::uint32_t key;
+    glm::dvec2 centre;  // its footprint's centre (world), and the square of its reach
+    double reach2;
     glm::dvec3 position;
     glm::dmat3 to_vehicle;  // world to vehicle
     glm::dvec3 lo, hi;      // its box in its own frame

@@ -317,6 +317,38 @@ TEST_F(SprayRenderTest, TheBeamsLightTheSprayAtNight) {
 
 // Spray behind a truck on a road with puddles, from the chase camera and from the driver's seat
 // (dry glass, so that the spray is what is seen).
+// The flooded road mirrors the spray: from the driver's seat behind the truck on 3 mm of water,
+// the road ahead mirrors the truck, and the spray's clouds over it fade its mirror image as they
+// fade the truck (lighter: the clouds scatter the sky's light). Without the clouds in the mirror,
+// its image of the truck stands dark and clear under the haze.
+TEST_F(SprayRenderTest, TheFloodedRoadMirrorsTheSpray) {
+  const sim::SceneState scene = behind_truck(3.0);
+  const sim::ViewSpec spec = view_spec(sim::View::kCockpit, 320, 180);
+  render::Renderer& r = renderer();
+  r.set_spray_in_mirror(false);
+  const RgbaImage without = render(spec, scene);
+  r.set_spray_in_mirror(true);
+  const RgbaImage with = render(spec, scene);
+  testing::write_png(::testing::TempDir() + "spray_mirror_without.png", without);
+  testing::write_png(::testing::TempDir() + "spray_mirror_with.png", with);
+  // The view's lower half: the road up to the bonnet.
+  double brighter = 0.0;
+  int changed = 0, n = 0;
+  for (int y = spec.height / 2; y < spec.height; ++y) {
+    for (int x = 0; x < spec.width; ++x, ++n) {
+      const double d = luma(with, x, y) - luma(without, x, y);
+      brighter += d;
+      changed += std::abs(d) > 2.0;
+    }
+  }
+  std::printf(
+      "the view's lower half with the spray in the road's mirror: %d of %d pixels changed by "
+      "more than 2 levels, mean %+.2f\n",
+      changed, n, brighter / n);
+  EXPECT_GT(changed, 200);
+  EXPECT_GT(brighter / n, 0.15);
+}
+
 TEST_F(SprayRenderTest, GoldenSprayBehindATruck) {
   const sim::SceneState scene = behind_truck(3.0);
   expect_golden(render(view_spec(sim::View::kRoad, 320, 180), scene), "spray_ROAD.png");

@@ -63,7 +63,9 @@ namespace downpour::render {
   X(kClientImage, 23, sampler2D, client_image_tex,                                                 \
     "a client-background view's picture (display-encoded)")                                        \
   X(kClientDepth, 24, sampler2D, client_depth_tex,                                                 \
-    "its depth, the view's reversed-Z (0 the sky or unknown)")
+    "its depth, the view's reversed-Z (0 the sky or unknown)")                                     \
+  X(kSprayMirrorHaze, 25, sampler2D, spray_mirror_haze_tex,                                        \
+    "the spray's haze seen in the road's mirror: r optical depth, g that times distance (m)")
 
 // The per-frame uniform block: X(GLSL type, name, comment). Every field is a vec4 or a mat4, so
 // the C++ struct below has the std140 layout as it is.

@@ -143,6 +143,22 @@ void SprayPass::execute(const FrameContext& frame, const FrameResources& resourc
   runs_of(all_tiles_, tiles_x, tiles_y, width, height, all_runs_);
 }
 
+// The cloud: spread over kCloudSpread times the parcel's radius (a parcel stands for a cloud that
+// merges with its neighbours', not a puff of its own), at least a haze pixel wide, its optical
+// depth thinned to keep its extinction. Parcels at the camera are too few to stand for the cloud
+// around it: they fade in from 0.5 to 3 m.
+bool spray_cloud(const sim::SprayImage::Point& p, const glm::vec3& v, float haze_pixel_m,
+                 SprayHazeBall& out) {
+  const float z = -v.z;
+  const float r = std::max(kCloudSpread * p.radius_m, haze_pixel_m);
+  const float near = std::clamp((z - 0.5f) / 2.5f, 0.0f, 1.0f);
+  const float depth =
+      p.haze_depth * (p.radius_m / r) * (p.radius_m / r) * near * near * (3.0f - 2.0f * near);
+  if (depth <= 0.002f) return false;
+  out = {{v, r}, std::min(depth, kMaxCloudDepth)};
+  return true;
+}
+
 // Culls the parcels to the view: the body's, the spray's and the clouds in view space, and the
 // tiles of the layer each touches.
 void SprayPass::cull(const FrameContext& frame, int width, int height, int tiles_x, int tiles_y) {
@@ -186,17 +202,10 @@ void SprayPass::cull(const FrameContext& frame, int width, int height, int tiles
       if (mark_all) mark(liquid_tiles_, tiles_x, tiles_y, centre, cover);
       if (body) mark(body_tiles_, tiles_x, tiles_y, centre, cover + kPlaneRadius);
     }
-    // The cloud: spread over kCloudSpread times the parcel's radius (a parcel stands for a cloud
-    // that merges with its neighbours', not a puff of its own), at least a haze pixel wide, its
-    // optical depth thinned to keep its extinction. Parcels at the camera are too few to stand for
-    // the cloud around it: they fade in from 0.5 to 3 m.
-    const float r = std::max(kCloudSpread * p.radius_m, kHazeScale * pixel_m);
-    const float near = std::clamp((z - 0.5f) / 2.5f, 0.0f, 1.0f);
-    const float depth =
-        p.haze_depth * (p.radius_m / r) * (p.radius_m / r) * near * near * (3.0f - 2.0f * near);
-    if (depth > 0.002f) {
-      clouds_.push_back({{v, r}, std::min(depth, kMaxCloudDepth)});
-      if (mark_all) mark(all_tiles_, tiles_x, tiles_y, centre, r / pixel_m + 1.0f);
+    SprayHazeBall cloud;
+    if (spray_cloud(p, v, kHazeScale * pixel_m, cloud)) {
+      clouds_.push_back(cloud);
+      if (mark_all) mark(all_tiles_, tiles_x, tiles_y, centre, cloud.ball.radius / pixel_m + 1.0f);
     }
   }
   drawn_.body = static_cast<std::uint32_t>(body_.size());

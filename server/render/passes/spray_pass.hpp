@@ -28,6 +28,7 @@
 #include "server/render/cpu/spray_splat.hpp"
 #include "server/render/gl/gl_objects.hpp"
 #include "server/render/pass.hpp"
+#include "server/sim/spray.hpp"
 #include "server/sim/worker_thread.hpp"
 
 namespace downpour::render {
@@ -42,6 +43,11 @@ class TileRuns {
   VertexArray vao_;
   Buffer buffer_;
 };
+
+// A parcel's cloud of droplets at view-space v, drawn into a haze map whose pixel spans
+// haze_pixel_m there: false where it is too thin to draw. (The view's spray and its mirror.)
+bool spray_cloud(const sim::SprayImage::Point& p, const glm::vec3& v, float haze_pixel_m,
+                 SprayHazeBall& out);
 
 class SprayPass final : public Pass {
  public:
