@@ -434,4 +434,13 @@ bool same_cabin(const sim::GlassConfig& a, const sim::GlassConfig& b) {
          a.top_width_mm == b.top_width_mm && a.height_mm == b.height_mm && a.rake_deg == b.rake_deg;
 }
 
+sim::ModelPtr bonnet_for(const sim::ModelPtr& body, const sim::GlassConfig& glass,
+                         const glm::dvec3& eye_m) {
+  if (same_cabin(glass, sim::GlassConfig{}) && eye_m == sim::EgoGeometry{}.eye_m) return nullptr;
+  auto own =
+      std::make_shared<VehicleModel>(body ? *body : default_vehicle(sim::VehicleClass::kCar));
+  mark_bonnet(*own, glass, eye_m);
+  return own;
+}
+
 }  // namespace downpour::model

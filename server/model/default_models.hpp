@@ -31,4 +31,10 @@ bool same_cabin(const sim::GlassConfig& a, const sim::GlassConfig& b);
 void mark_bonnet(VehicleModel& model, const sim::GlassConfig& glass = {},
                  const glm::dvec3& eye_m = sim::EgoGeometry{}.eye_m);
 
+// The body (null: the built-in car) marked for a session's glass and eye, for
+// EgoGeometry::bonnet_model: null where both are the defaults (the library's bodies and the
+// built-in car are marked for those), else a copy marked for them.
+sim::ModelPtr bonnet_for(const sim::ModelPtr& body, const sim::GlassConfig& glass,
+                         const glm::dvec3& eye_m);
+
 }  // namespace downpour::model

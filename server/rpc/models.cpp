@@ -79,13 +79,8 @@ grpc::Status to_ego_models(model::ModelLibrary& library, const v1::EgoVehicle& i
   if (auto s = to_cabin_model(library, in, field, config); !s.ok()) return s;
   // The library marks a body's bonnet for the default glass and eye (what the driver sees past
   // the glass's foot); a session with another glass or eye gets a copy marked for its own.
-  const sim::ModelPtr& body = config->ego.body_model;
-  if (body && (!model::same_cabin(config->glass, sim::GlassConfig{}) ||
-               config->ego.eye_m != sim::EgoGeometry{}.eye_m)) {
-    auto own = std::make_shared<model::VehicleModel>(*body);
-    model::mark_bonnet(*own, config->glass, config->ego.eye_m);
-    config->ego.body_model = std::move(own);
-  }
+  config->ego.bonnet_model =
+      model::bonnet_for(config->ego.body_model, config->glass, config->ego.eye_m);
   return grpc::Status::OK;
 }
 

@@ -146,6 +146,9 @@ struct EgoGeometry {
   glm::dvec3 eye_m{1.05, 0.37, 1.22};  // the driver's eye: the COCKPIT and RAIN views' camera
   ModelPtr body_model;                 // null: the built-in car
   ModelPtr cabin_model;                // null: the built-in cabin round the glass
+  // The body as the driver sees it past this session's glass and eye (model::bonnet_for): null
+  // where they are the defaults, for which the body is marked already.
+  ModelPtr bonnet_model;
 };
 
 enum class Background { kRendered, kClient };

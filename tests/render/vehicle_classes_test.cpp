@@ -297,7 +297,9 @@ TEST_F(VehicleClassesTest, TheBonnetFollowsTheSessionsGlass) {
   sim::SceneState s = dry_scene();
   const sim::ViewSpec spec = sim::view_spec(sim::View::kCockpit, 640, 360);
   const RgbaImage usual = render(spec, s);
+  ASSERT_EQ(model::bonnet_for(nullptr, s.glass, s.ego.eye_m), nullptr);  // marked already
   s.glass.bottom_left_m.x -= 0.15;
+  s.ego.bonnet_model = model::bonnet_for(nullptr, s.glass, s.ego.eye_m);  // as rpc/models.cpp
   const RgbaImage back = render(spec, s);
   if (const char* dir = std::getenv("DOWNPOUR_TEST_IMAGES")) {
     testing::write_png(std::string(dir) + "/bonnet_default_glass.png", usual);

@@ -54,19 +54,8 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
           frame.scene.ego_body_wet);
   const auto car = static_cast<std::size_t>(sim::VehicleClass::kCar);
   const ModelMesh* ego = ego_model ? &named_.get(ego_model) : &near_[car];
-  const sim::GlassConfig& glass = frame.scene.glass;
-  const glm::dvec3& eye = frame.scene.ego.eye_m;
-  if (cockpit && !ego_model &&
-      (!model::same_cabin(glass, sim::GlassConfig{}) || eye != sim::EgoGeometry{}.eye_m)) {
-    if (!own_bonnet_ || !model::same_cabin(glass, own_bonnet_glass_) || eye != own_bonnet_eye_) {
-      model::VehicleModel m = model::default_vehicle(sim::VehicleClass::kCar);
-      model::mark_bonnet(m, glass, eye);
-      own_bonnet_ = std::make_unique<ModelMesh>(m);
-      own_bonnet_glass_ = glass;
-      own_bonnet_eye_ = eye;
-    }
-    ego = own_bonnet_.get();
-  }
+  // From the seat, the body as marked for the session's glass and eye (where they differ).
+  if (cockpit && frame.scene.ego.bonnet_model) ego = &named_.get(frame.scene.ego.bonnet_model);
   ego->draw(uniforms_, glm::scale(frame.vehicle_to_world, ego_scale), frame.scene.ego_rolled_m,
             cockpit);
   // A vehicle under 40 pixels tall is drawn from its model for the distance.

@@ -34,11 +34,6 @@ class VehiclePass final : public Pass {
   // class. The models sessions name, as their scenes hold them.
   std::vector<ModelMesh> near_, far_;
   ModelMeshes named_;
-  // The built-in car marked for the bonnet a scene's glass and eye show, where they are not the
-  // default car's (mark_bonnet; remade when they change).
-  std::unique_ptr<ModelMesh> own_bonnet_;
-  sim::GlassConfig own_bonnet_glass_;
-  glm::dvec3 own_bonnet_eye_{0.0};
 };
 
 }  // namespace downpour::render
