@@ -2,7 +2,8 @@
 // sessions' models go through (model/gltf_model.hpp), tinygltf's parser included. The first byte
 // picks the kind. A model read must hold what the renderer assumes: indices within its vertices,
 // finite positions, wheels' ranges within its indices; written out and read again, it must give
-// the same triangles. Nothing may crash, leak or hit undefined behaviour.
+// the same triangles; its textures are whole layers that its vertices name. Nothing may crash, leak
+// or hit undefined behaviour.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -31,6 +32,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   limits.max_bytes = 1u << 20;
   limits.max_triangles = 20'000;
   limits.max_node_visits = 4096;
+  limits.max_image_side = 256;
+  limits.max_image_pixels = 1u << 18;
   VehicleModel m;
   try {
     m = read_gltf(bytes, kind, limits);
@@ -45,6 +48,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     require(std::isfinite(v.position.x) && std::isfinite(v.position.y) &&
             std::isfinite(v.position.z) && std::isfinite(v.normal.x));
   require(m.fixed_index_count <= m.mesh.indices.size());
+  // Textures: a layer each of the set size, every vertex reading one of them or none.
+  require(m.mesh.texcoords.empty() == m.textures.empty());
+  require(m.mesh.texcoords.empty() || m.mesh.texcoords.size() == n);
+  for (const ModelTexture& t : m.textures)
+    require(t.rgba.size() == static_cast<std::size_t>(kModelTextureSide) * kModelTextureSide * 4);
+  for (const auto& t : m.mesh.texcoords)
+    require(t.layer == -1.0f ||
+            (t.layer >= 0.0f && t.layer < static_cast<float>(m.textures.size()) &&
+             std::isfinite(t.uv.x) && std::isfinite(t.uv.y)));
   for (const Wheel& w : m.wheels) {
     require(w.first_index + w.index_count <= m.mesh.indices.size());
     require(std::isfinite(w.radius_m) && w.radius_m > 0.0f);

@@ -3,6 +3,8 @@
 in vec3 v_world;
 in vec3 v_normal;
 in vec2 v_uv;  // x material id (MATERIAL_*, interface.glsl)
+in vec3 v_texture;  // where it reads model_tex: uv, layer (-1: none)
+uniform float u_textured;  // 1 where the model has textures, else 0
 out vec4 out_colour;
 void main() {
   vec3 n = normalize(v_normal);
@@ -10,6 +12,9 @@ void main() {
   n = dot(n, view) < 0.0 ? -n : n;
   // Dark plastic lit mostly by the sky through the glass: the silhouettes frame the view.
   vec3 albedo = int(v_uv.x + 0.5) == MATERIAL_BODY ? vec3(0.05) : trim_colour(v_uv.y, vec3(0.028, 0.028, 0.03));
+  // A glTF cabin's base-colour texture times its colour (uniform control flow, as vehicle.frag).
+  if (u_textured > 0.5)
+    albedo *= mix(vec3(1.0), texture(model_tex, v_texture).rgb, step(-0.5, v_texture.z));
   vec3 light = frame.ambient.rgb * (0.35 + 0.4 * max(n.z, 0.0)) + frame.sun_radiance.rgb * 0.15 * max(dot(n, frame.sun_dir.xyz), 0.0);
   float sheen = schlick(dot(n, view), 0.03) * 0.3;
   out_colour = vec4(to_display(albedo * light + frame.sky_horizon.rgb * sheen), 1.0);

@@ -27,7 +27,10 @@ uniform vec2 u_near_split;
 uniform int u_wheel_count;
 uniform ivec2 u_wheel_vertices[MAX_WHEELS];
 uniform vec4 u_wheel_turn[MAX_WHEELS];
+// Where the vertex reads the model's textures (mesh_data.hpp's VertexTexture: uv, layer or -1).
+layout(location = 6) in vec3 a_texture;
 #endif
+out vec3 v_texture;  // (-1: no texture, for the meshes without them)
 #ifdef ROAD_LANES
 layout(location = 5) in vec4 a_lane;  // mesh_data.hpp's VertexLane
 flat out vec4 v_strip;
@@ -56,6 +59,11 @@ void main() {
 #endif
 #ifdef ROAD_LANES
   v_strip = a_lane;
+#endif
+#ifdef MESH_WHEELS
+  v_texture = a_texture;
+#else
+  v_texture = vec3(0.0, 0.0, -1.0);
 #endif
   gl_Position = frame.view_proj * world;
   // The road reflection keeps what is above the road; other frames' plane keeps everything (a

@@ -11,6 +11,8 @@ uniform vec3 u_body_colour;
 uniform vec4 u_lamps;
 uniform float u_head;
 uniform float u_wet;  // how wet the spray has made this body (0 dry to 1)
+in vec3 v_texture;  // where it reads model_tex: uv, layer (-1: none)
+uniform float u_textured;  // 1 where the model has textures, else 0
 // A lit lamp's lens as radiance: its luminance (cd/m^2) times the exposure, at least `floor`
 // (by day a lit lamp still stands out from its housing), at most `cap` (a camera's red channel
 // clips long before the others: a red lamp's core stays red).
@@ -48,6 +50,14 @@ void main() {
     albedo = vec3(0.35, 0.2, 0.02);
     float on = material == MATERIAL_INDICATOR_LEFT ? u_lamps.z : u_lamps.w;
     emit = lens(amber, 5000.0, 1.0, 3.0) * on;
+  }
+  // A glTF model's base-colour texture times the paint's or the trim's colour (sampled in uniform
+  // control flow, for its derivatives; a vertex without one reads none).
+  if (u_textured > 0.5) {
+    vec3 t = texture(model_tex, v_texture).rgb;
+    float own = step(-0.5, v_texture.z) *
+                float(material == MATERIAL_BODY || material == MATERIAL_TRIM);
+    albedo *= mix(vec3(1.0), t, own);
   }
   // Wet paint and trim (the weather's wetness, or the spray's that this body stopped): water in
   // the finish's roughness deepens its colour, as on the wet ground, and a film of it makes the

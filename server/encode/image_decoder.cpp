@@ -14,14 +14,28 @@ namespace {
 
 std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
-void check_size(const char* kind, int w, int h, int width, int height) {
-  if (w != width || h != height) {
-    throw DecodeError(std::string("the ") + kind + " is " + size_text(w, h) + ", the view is " +
-                      size_text(width, height));
+// The size a picture must have: exactly width x height (a view's), or, with `up_to`, at most
+// that each way (a model's texture).
+struct Expect {
+  int width = 0, height = 0;
+  bool up_to = false;
+};
+
+// Why a picture of w x h is not as expected; empty if it is.
+std::string size_error(const char* kind, int w, int h, Expect e) {
+  if (e.up_to) {
+    if (w < 1 || h < 1 || w > e.width || h > e.height)
+      return std::string("the ") + kind + " is " + size_text(w, h) + ", over the limit of " +
+             size_text(e.width, e.height);
+    return {};
   }
+  if (w != e.width || h != e.height)
+    return std::string("the ") + kind + " is " + size_text(w, h) + ", the view is " +
+           size_text(e.width, e.height);
+  return {};
 }
 
-BgrxPixels decode_jpeg(std::string_view bytes, int width, int height) {
+BgrxPixels decode_jpeg(std::string_view bytes, Expect expect) {
   std::unique_ptr<void, int (*)(tjhandle)> handle(tjInitDecompress(), &tjDestroy);
   if (!handle) throw std::runtime_error("tjInitDecompress failed");
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
@@ -30,7 +44,8 @@ BgrxPixels decode_jpeg(std::string_view bytes, int width, int height) {
       0) {
     throw DecodeError(std::string("not a JPEG that decodes: ") + tjGetErrorStr2(handle.get()));
   }
-  check_size("JPEG", w, h, width, height);
+  if (const std::string why = size_error("JPEG", w, h, expect); !why.empty())
+    throw DecodeError(why);
   BgrxPixels out{w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h * 4)};
   if (tjDecompress2(handle.get(), data, bytes.size(), out.bgrx.data(), w, 0, h, TJPF_BGRX,
                     TJFLAG_FASTDCT | TJFLAG_BOTTOMUP) != 0 &&
@@ -77,7 +92,7 @@ struct PngReader {
   }
   // Reads the header: the picture's size, which must be width x height; a grey16 one must be one
   // 16-bit grey channel.
-  std::pair<int, int> read_header(int width, int height, bool grey16) {
+  std::pair<int, int> read_header(Expect expect, bool grey16) {
     png_read_info(png, info);
     const int w = static_cast<int>(png_get_image_width(png, info));
     const int h = static_cast<int>(png_get_image_height(png, info));
@@ -86,8 +101,8 @@ struct PngReader {
       error = "not a 16-bit grey PNG";
       fail();
     }
-    if (w != width || h != height) {
-      error = "the PNG is " + size_text(w, h) + ", the view is " + size_text(width, height);
+    if (std::string why = size_error("PNG", w, h, expect); !why.empty()) {
+      error = std::move(why);
       fail();
     }
     return {w, h};
@@ -118,13 +133,13 @@ void read_rows(PngReader& r, std::vector<png_bytep>& rows, std::uint8_t* out, st
   png_read_end(r.png, nullptr);
 }
 
-BgrxPixels decode_png_bgrx(std::string_view bytes, int width, int height) {
+BgrxPixels decode_png_bgrx(std::string_view bytes, Expect expect) {
   PngReader r(bytes);
   BgrxPixels out;
   std::vector<png_bytep> rows;
   // (No object with a destructor is made between the setjmp and a longjmp back to it.)
   if (setjmp(png_jmpbuf(r.png))) r.rethrow();
-  const auto [w, h] = r.read_header(width, height, false);
+  const auto [w, h] = r.read_header(expect, false);
   png_set_expand(r.png);  // palette to RGB, grey under 8 bits to 8, tRNS to alpha
   png_set_strip_16(r.png);
   png_set_gray_to_rgb(r.png);
@@ -158,8 +173,15 @@ bool is_png(std::string_view b) {
 }
 
 BgrxPixels decode_bgrx(std::string_view bytes, int width, int height) {
-  if (is_jpeg(bytes)) return decode_jpeg(bytes, width, height);
-  if (is_png(bytes)) return decode_png_bgrx(bytes, width, height);
+  if (is_jpeg(bytes)) return decode_jpeg(bytes, {width, height});
+  if (is_png(bytes)) return decode_png_bgrx(bytes, {width, height});
+  throw DecodeError(bytes.empty() ? "empty" : "neither a JPEG nor a PNG");
+}
+
+BgrxPixels decode_bgrx_up_to(std::string_view bytes, int max_side) {
+  const Expect expect{max_side, max_side, true};
+  if (is_jpeg(bytes)) return decode_jpeg(bytes, expect);
+  if (is_png(bytes)) return decode_png_bgrx(bytes, expect);
   throw DecodeError(bytes.empty() ? "empty" : "neither a JPEG nor a PNG");
 }
 
@@ -172,7 +194,7 @@ Grey16Pixels decode_png_grey16(std::string_view bytes, int width, int height) {
   Grey16Pixels out;
   std::vector<png_bytep> rows;
   if (setjmp(png_jmpbuf(r.png))) r.rethrow();
-  const auto [w, h] = r.read_header(width, height, true);
+  const auto [w, h] = r.read_header({width, height}, true);
   png_set_swap(r.png);  // PNG's big-endian samples to this machine's order
   png_set_interlace_handling(r.png);
   png_read_update_info(r.png, r.info);

@@ -1,6 +1,7 @@
-// Pictures from clients (a simulator's camera and depth images), decoded with their size checked
-// before any pixel is: JPEG through TurboJPEG, PNG through libpng. Untrusted bytes: every failure
-// is a DecodeError whose message says what is wrong, in words a client can act on.
+// Pictures from clients (a simulator's camera and depth images, a model's textures), decoded with
+// their size checked before any pixel is: JPEG through TurboJPEG, PNG through libpng. Untrusted
+// bytes: every failure is a DecodeError whose message says what is wrong, in words a client can act
+// on.
 #pragma once
 
 #include <cstdint>
@@ -38,6 +39,8 @@ bool is_png(std::string_view bytes);
 // A JPEG or PNG (grey, RGB, palette, with or without alpha; 16-bit channels are taken to 8) of
 // exactly width x height.
 BgrxPixels decode_bgrx(std::string_view bytes, int width, int height);
+// The same of any size up to max_side x max_side (a model's texture).
+BgrxPixels decode_bgrx_up_to(std::string_view bytes, int max_side);
 // A PNG of one 16-bit grey channel (no other kind: a depth must not be rounded or converted), of
 // exactly width x height, its values as stored.
 Grey16Pixels decode_png_grey16(std::string_view bytes, int width, int height);

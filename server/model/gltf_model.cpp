@@ -21,6 +21,7 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
+#include "server/encode/image_decoder.hpp"
 #include "server/model/tinygltf.hpp"
 
 #include "server/model/materials.hpp"
@@ -146,9 +147,58 @@ bool write_file(std::string* err, const std::string&, const std::vector<unsigned
   return false;
 }
 
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-                const unsigned char*, int, void*) {
-  return true;  // textures are not read
+// The loader's images are kept as their file's bytes (PNG or JPEG); the reader decodes those a
+// material takes as its base colour, with their size checked first (encode/image_decoder.hpp).
+bool keep_image(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                const unsigned char* bytes, int size, void*) {
+  image->image.assign(bytes, bytes + std::max(size, 0));
+  image->width = image->height = image->component = 0;
+  return true;
+}
+
+// sRGB-encoded 8 bits to linear light, and back (the texture's resampling averages light).
+float srgb_to_linear(int c) {
+  const float x = static_cast<float>(c) / 255.0f;
+  return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f);
+}
+std::uint8_t linear_to_srgb(float x) {
+  x = std::clamp(x, 0.0f, 1.0f);
+  const float c = x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
+  return static_cast<std::uint8_t>(std::lround(c * 255.0f));
+}
+
+// A decoded picture (BGRX, rows bottom-up) as a layer: each texel the mean of the pixels its
+// square covers (at least the nearest one), in linear light; RGBA, rows from the top.
+ModelTexture to_layer(const encode::BgrxPixels& p) {
+  static const std::array<float, 256> lut = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) t[i] = srgb_to_linear(i);
+    return t;
+  }();
+  constexpr int n = kModelTextureSide;
+  ModelTexture out;
+  out.rgba.resize(static_cast<std::size_t>(n) * n * 4);
+  for (int y = 0; y < n; ++y) {
+    const int sy0 = y * p.height / n, sy1 = std::max(sy0 + 1, (y + 1) * p.height / n);
+    for (int x = 0; x < n; ++x) {
+      const int sx0 = x * p.width / n, sx1 = std::max(sx0 + 1, (x + 1) * p.width / n);
+      float sum[3] = {0.0f, 0.0f, 0.0f}, alpha = 0.0f;
+      for (int sy = sy0; sy < sy1; ++sy) {
+        // (rows bottom-up: the picture's row sy from the top)
+        const std::uint8_t* row =
+            &p.bgrx[static_cast<std::size_t>(p.height - 1 - sy) * p.width * 4];
+        for (int sx = sx0; sx < sx1; ++sx) {
+          const std::uint8_t* q = row + static_cast<std::size_t>(sx) * 4;
+          sum[0] += lut[q[2]], sum[1] += lut[q[1]], sum[2] += lut[q[0]], alpha += q[3];
+        }
+      }
+      const float k = 1.0f / static_cast<float>((sy1 - sy0) * (sx1 - sx0));
+      std::uint8_t* o = &out.rgba[(static_cast<std::size_t>(y) * n + x) * 4];
+      for (int c = 0; c < 3; ++c) o[c] = linear_to_srgb(sum[c] * k);
+      o[3] = static_cast<std::uint8_t>(std::lround(alpha * k));
+    }
+  }
+  return out;
 }
 
 // --- from tinygltf's model to ours ------------------------------------------------------------
@@ -170,6 +220,29 @@ class Accessors {
     for (std::size_t i = 0; i < a.count; ++i) std::memcpy(&out[i * n], data + i * stride, 4 * n);
     for (float v : out)
       if (!std::isfinite(v)) throw ModelError(std::string(what) + " holds a number not finite");
+    return out;
+  }
+
+  // TEXCOORD_n: two floats, or two normalized unsigned bytes or shorts.
+  std::vector<float> texcoords(int index, const char* what) const {
+    const tinygltf::Accessor& a = accessor(index, what);
+    if (a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT)
+      return floats(index, TINYGLTF_TYPE_VEC2, what);
+    const int size = a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? 1
+                     : a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 2
+                                                                                 : 0;
+    if (a.type != TINYGLTF_TYPE_VEC2 || size == 0 || !a.normalized)
+      throw ModelError(std::string(what) +
+                       " must be two floats, or two normalized unsigned bytes or shorts");
+    const auto [data, stride] = locate(a, 2 * size, what);
+    std::vector<float> out(a.count * 2);
+    for (std::size_t i = 0; i < a.count; ++i) {
+      for (int c = 0; c < 2; ++c) {
+        const unsigned char* q = data + i * stride + c * size;
+        out[2 * i + c] =
+            size == 1 ? q[0] / 255.0f : static_cast<float>(q[0] | q[1] << 8) / 65535.0f;
+      }
+    }
     return out;
   }
 
@@ -249,6 +322,7 @@ struct Shade {
   float material = material::kTrim;
   float colour = 0.0f;  // pack_trim_colour, or 0
   bool windshield = false;
+  int texture = -1;  // the glTF texture of its base colour (on TEXCOORD_0), or -1
 };
 
 Shade shade_of(const tinygltf::Model& m, int index, ModelKind kind) {
@@ -264,11 +338,19 @@ Shade shade_of(const tinygltf::Model& m, int index, ModelKind kind) {
   if (has(name, {"indicator_right", "blinker_right", "turn_right"}))
     return {material::kIndicatorRight};
   if (has(name, {"tail", "brake"})) return {material::kLamp};
-  if (has(name, {"paint", "body"})) return {material::kBody};
-  // Its own colour; glTF's default, white, is the built-in dark trim.
+  // A base-colour texture on the first uv set: the texture times the colour (paint: times the
+  // vehicle's own colour).
+  const tinygltf::TextureInfo& base = mat.pbrMetallicRoughness.baseColorTexture;
+  const int texture = base.index >= 0 && base.texCoord == 0 ? base.index : -1;
   const std::vector<double>& c = mat.pbrMetallicRoughness.baseColorFactor;
-  if (c.size() >= 3 && !(c[0] == 1.0 && c[1] == 1.0 && c[2] == 1.0))
-    return {material::kTrim, pack_trim_colour(c[0], c[1], c[2])};
+  const bool white = c.size() < 3 || (c[0] == 1.0 && c[1] == 1.0 && c[2] == 1.0);
+  if (has(name, {"paint", "body"})) return {material::kBody, 0.0f, false, texture};
+  if (texture >= 0)
+    return {material::kTrim,
+            white ? pack_trim_colour(1.0, 1.0, 1.0) : pack_trim_colour(c[0], c[1], c[2]), false,
+            texture};
+  // Its own colour; glTF's default, white, is the built-in dark trim.
+  if (!white) return {material::kTrim, pack_trim_colour(c[0], c[1], c[2])};
   return {};
 }
 
@@ -278,6 +360,8 @@ struct Gathered {
   std::map<int, std::vector<std::uint32_t>> parts;  // wheel number (or -1) -> indices
   std::vector<glm::dvec3> windshield;               // its triangles' corners, in threes
   std::size_t triangles = 0;
+  std::vector<render::VertexTexture> texcoords;  // one a vertex
+  std::vector<ModelTexture> textures;
 };
 
 class Reader {
@@ -369,16 +453,32 @@ class Reader {
       }
       std::vector<std::uint32_t>& part = out_.parts[wheel];
       const glm::vec2 uv(shade.material, shade.colour);
+      // Where each vertex reads the texture, if the material has one.
+      std::vector<float> tex;
+      float layer = -1.0f;
+      if (shade.texture >= 0) {
+        if (const auto it = p.attributes.find("TEXCOORD_0"); it != p.attributes.end()) {
+          tex = accessors_.texcoords(it->second, "TEXCOORD_0");
+          if (tex.size() != 2 * n) throw ModelError("TEXCOORD_0 and POSITION counts differ");
+          layer = static_cast<float>(layer_of(shade.texture));
+        }
+      }
+      auto texcoord = [&](std::size_t i) {
+        return layer < 0.0f ? render::VertexTexture{}
+                            : render::VertexTexture{{tex[2 * i], tex[2 * i + 1]}, layer};
+      };
       if (nor.empty()) {  // flat normals: each triangle its own corners
         for (std::size_t t = 0; t < idx.size(); t += 3) {
-          glm::dvec3 a = v[idx[t]], b = v[idx[t + 1]], c = v[idx[t + 2]];
-          if (flip) std::swap(b, c);
+          std::uint32_t ia = idx[t], ib = idx[t + 1], ic = idx[t + 2];
+          if (flip) std::swap(ib, ic);
+          const glm::dvec3 a = v[ia], b = v[ib], c = v[ic];
           glm::dvec3 nn = glm::cross(b - a, c - a);
           const double len = glm::length(nn);
           nn = len > 0.0 ? nn / len : glm::dvec3(0.0, 0.0, 1.0);
-          for (const glm::dvec3& q : {a, b, c}) {
+          for (const std::uint32_t q : {ia, ib, ic}) {
             part.push_back(static_cast<std::uint32_t>(out_.vertices.size()));
-            out_.vertices.push_back({glm::vec3(q), glm::vec3(nn), uv});
+            out_.vertices.push_back({glm::vec3(v[q]), glm::vec3(nn), uv});
+            out_.texcoords.push_back(texcoord(q));
           }
         }
         continue;
@@ -390,6 +490,7 @@ class Reader {
         const double len = glm::length(nn);
         nn = len > 0.0 ? nn / len : glm::dvec3(0.0, 0.0, 1.0);
         out_.vertices.push_back({glm::vec3(v[i]), glm::vec3(nn), uv});
+        out_.texcoords.push_back(texcoord(i));
       }
       for (std::size_t t = 0; t < idx.size(); t += 3) {
         part.push_back(base + idx[t]);
@@ -399,11 +500,43 @@ class Reader {
     }
   }
 
+  // The model's layer for glTF texture t: its image decoded and resampled the first time.
+  int layer_of(int t) {
+    if (static_cast<std::size_t>(t) >= m_.textures.size())
+      throw ModelError("a material names a texture that does not exist");
+    const int source = m_.textures[t].source;
+    if (source < 0 || static_cast<std::size_t>(source) >= m_.images.size())
+      throw ModelError("texture " + std::to_string(t) + " names no image");
+    if (const auto it = layers_.find(source); it != layers_.end()) return it->second;
+    if (static_cast<int>(out_.textures.size()) >= limits_.max_textures)
+      throw ModelError("the model has more than " + std::to_string(limits_.max_textures) +
+                       " base-colour textures");
+    const std::vector<unsigned char>& bytes = m_.images[source].image;
+    encode::BgrxPixels pixels;
+    try {
+      pixels = encode::decode_bgrx_up_to(
+          std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
+          limits_.max_image_side);
+    } catch (const encode::DecodeError& e) {
+      throw ModelError("image " + std::to_string(source) + ": " + e.what());
+    }
+    image_pixels_ += static_cast<std::size_t>(pixels.width) * pixels.height;
+    if (image_pixels_ > limits_.max_image_pixels)
+      throw ModelError("the model's images hold more than " +
+                       std::to_string(limits_.max_image_pixels) + " pixels");
+    out_.textures.push_back(to_layer(pixels));
+    const int layer = static_cast<int>(out_.textures.size()) - 1;
+    layers_[source] = layer;
+    return layer;
+  }
+
   const tinygltf::Model& m_;
   ModelKind kind_;
   const ModelLimits& limits_;
   Accessors accessors_;
   Gathered out_;
+  std::map<int, int> layers_;  // image -> layer
+  std::size_t image_pixels_ = 0;
   std::size_t visits_ = 0;
   int wheels_ = 0;
 };
@@ -499,6 +632,10 @@ VehicleModel assemble(Gathered g, ModelKind kind) {
   }
   const glm::vec3 shift(-origin);
   for (render::MeshVertex& v : g.vertices) out.mesh.add_vertex(v.position + shift, v.normal, v.uv);
+  if (!g.textures.empty()) {
+    out.mesh.texcoords = std::move(g.texcoords);
+    out.textures = std::move(g.textures);
+  }
   std::uint32_t at = 0;
   auto append = [&](const std::vector<std::uint32_t>& indices) {
     out.mesh.indices.insert(out.mesh.indices.end(), indices.begin(), indices.end());
@@ -537,7 +674,7 @@ VehicleModel read_gltf(std::string_view bytes, ModelKind kind, const ModelLimits
   Files files{beside, limits.max_bytes - bytes.size()};
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({&file_exists, &expand_path, &read_file, &write_file, &files});
-  loader.SetImageLoader(&skip_image, nullptr);
+  loader.SetImageLoader(&keep_image, nullptr);
   tinygltf::Model m;
   std::string err, warn;
   const std::string base = beside.empty() ? std::string() : beside.string();

@@ -36,6 +36,11 @@ struct ModelLimits {
   std::size_t max_triangles = 500'000;
   std::size_t max_node_visits = 65'536;  // nodes through the hierarchy, instances counted
   int max_depth = 64;                    // of the JSON and of the node hierarchy
+  // Images (PNG or JPEG) it carries: each at most this wide and tall, all of them at most this
+  // many pixels; base-colour textures at most this many.
+  int max_image_side = 4096;
+  std::size_t max_image_pixels = 32u << 20;
+  int max_textures = 16;
 };
 
 enum class ModelKind { kVehicle, kCabin };

@@ -44,10 +44,18 @@ struct VertexLane {
 // the border (cm, + 64; left positive), 17-23 a double line's spacing (cm).
 float pack_lane_mark(int kind, bool yellow, double width_m, double offset_m, double spacing_m);
 
+// Where a model's vertex reads its texture (vehicle_model.hpp's textures), a fourth vertex stream:
+// attribute 6. Layer -1: none (the material's own colour alone).
+struct VertexTexture {
+  glm::vec2 uv{0.0f};  // glTF's: (0, 0) the image's top left
+  float layer = -1.0f;
+};
+
 struct MeshData {
   std::vector<MeshVertex> vertices;
   std::vector<VertexCurvature> curvature;  // empty, or one a vertex
   std::vector<VertexLane> lanes;           // empty, or one a vertex
+  std::vector<VertexTexture> texcoords;    // empty, or one a vertex
   std::vector<std::uint32_t> indices;
   glm::vec3 bounds_min{1e30f};
   glm::vec3 bounds_max{-1e30f};

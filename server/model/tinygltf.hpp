@@ -1,4 +1,5 @@
-// tinygltf as this project builds it (tinygltf_impl.cpp): without its image decoders and its file
+// tinygltf as this project builds it (tinygltf_impl.cpp): without its image decoders (images come
+// to gltf_model.cpp as their bytes, external ones through its file checks) and its file
 // system, so that the class's defaults agree between its code and its users.
 #pragma once
 
@@ -6,6 +7,5 @@
 
 #define TINYGLTF_NO_STB_IMAGE
 #define TINYGLTF_NO_STB_IMAGE_WRITE
-#define TINYGLTF_NO_EXTERNAL_IMAGE
 #define TINYGLTF_NO_FS
 #include <tiny_gltf.h>

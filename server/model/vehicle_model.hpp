@@ -78,8 +78,16 @@ inline WindshieldOutline outline_of(const sim::GlassConfig& g) {
   return w;
 }
 
+// A model's base-colour textures, each resampled to one layer of kModelTextureSide squared: RGBA,
+// 8 bits, sRGB-encoded, rows from the image's top (glTF's uv (0, 0)).
+inline constexpr int kModelTextureSide = 512;
+struct ModelTexture {
+  std::vector<std::uint8_t> rgba;  // kModelTextureSide^2 * 4
+};
+
 struct VehicleModel {
-  render::MeshData mesh;
+  render::MeshData mesh;  // with texcoords where it has textures
+  std::vector<ModelTexture> textures;
   std::uint32_t fixed_index_count = 0;  // [0, this): the parts that do not turn
   // [0, this): of those, the ones drawn from the driver's seat (mark_bonnet, default_models.hpp)
   std::uint32_t bonnet_index_count = 0;

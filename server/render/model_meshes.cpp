@@ -7,6 +7,8 @@
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "server/render/cpu/shader_interface.hpp"
+
 namespace downpour::render {
 
 namespace {
@@ -56,18 +58,38 @@ ModelUniforms::ModelUniforms(const ShaderProgram& program)
     : model(program.uniform("u_model")),
       wheel_count(program.uniform("u_wheel_count")),
       wheel_vertices(program.uniform("u_wheel_vertices")),
-      wheel_turn(program.uniform("u_wheel_turn")) {}
+      wheel_turn(program.uniform("u_wheel_turn")),
+      textured(program.uniform("u_textured")) {}
 
 ModelMesh::ModelMesh(const model::VehicleModel& m)
     : mesh(m.mesh),
       fixed(m.fixed_index_count),
       bonnet(m.bonnet_index_count),
       wheels(m.wheels),
-      wheel_vertices(wheel_vertex_ranges(m)) {}
+      wheel_vertices(wheel_vertex_ranges(m)) {
+  if (m.textures.empty()) return;
+  constexpr int side = model::kModelTextureSide;
+  const auto layers = static_cast<GLsizei>(m.textures.size());
+  GLuint id = 0;
+  glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
+  textures = Texture(id);
+  glTextureStorage3D(id, 10, GL_SRGB8_ALPHA8, side, side, layers);  // 512 down to 1
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  for (GLsizei l = 0; l < layers; ++l)
+    glTextureSubImage3D(id, 0, 0, 0, l, side, side, 1, GL_RGBA, GL_UNSIGNED_BYTE,
+                        m.textures[static_cast<std::size_t>(l)].rgba.data());
+  glGenerateTextureMipmap(id);
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_REPEAT);
+}
 
 void ModelMesh::draw(const ModelUniforms& u, const glm::mat4& model, double rolled_m,
                      bool bonnet_only) const {
   u.model.set(model);
+  u.textured.set(textures.id() != 0 ? 1.0f : 0.0f);
+  if (textures.id() != 0) glBindTextureUnit(texture_unit::kModelTexture, textures.id());
   if (bonnet_only || wheels.empty()) {
     u.wheel_count.set(0);
     mesh.draw(0, bonnet_only ? bonnet : fixed);

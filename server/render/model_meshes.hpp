@@ -25,7 +25,7 @@ namespace downpour::render {
 // model.vert's uniforms (mesh_vertex.glsl).
 struct ModelUniforms {
   explicit ModelUniforms(const ShaderProgram& program);
-  Uniform model, wheel_count, wheel_vertices, wheel_turn;
+  Uniform model, wheel_count, wheel_vertices, wheel_turn, textured;
 };
 
 // A model on the GPU: its mesh, and where its parts lie in it.
@@ -38,6 +38,8 @@ struct ModelMesh {
   std::vector<model::Wheel> wheels;
   // Each wheel's vertices, [x, y), where they are the wheel's alone; empty where not.
   std::vector<glm::ivec2> wheel_vertices;
+  // Its base-colour textures as a layer each (none: 0), bound to model_tex for its draws.
+  Texture textures;
 
   // Draws it with `model` as the uniform u_model: the fixed parts (or the bonnet alone), and each
   // wheel turned by rolled_m over its radius.

@@ -2,6 +2,7 @@
 // long and as tall in the image as their sizes say, each in its own shape. The ego car's geometry
 // (EgoGeometry): its size seen from outside, its eye in the cabin.
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -309,6 +310,62 @@ TEST_F(VehicleClassesTest, TheBonnetFollowsTheSessionsGlass) {
               red(usual), red(back));
   EXPECT_GT(red(usual), 2000);
   EXPECT_GT(red(back), red(usual) * 9 / 10);
+}
+
+// A model's base-colour texture shows: the white truck 25 m ahead, its every vertex reading a
+// texture red on the left half and blue on the right (u = 0.25 on the truck's right side, 0.75
+// on its left), its paint times the texture: its rear shows red on the right, blue on the left.
+TEST_F(VehicleClassesTest, AModelsTextureShows) {
+  sim::SceneState s = dry_scene();
+  const sim::ViewSpec spec = sim::view_spec(sim::View::kCockpit, 640, 360);
+  const sim::TrafficVehicle v = in_lane(s, sim::VehicleClass::kTruck, 5, 25.0, true);  // white
+  auto textured = std::make_shared<model::VehicleModel>(model::default_vehicle(v.vehicle_class));
+  constexpr int n = model::kModelTextureSide;
+  model::ModelTexture layer;
+  layer.rgba.resize(static_cast<std::size_t>(n) * n * 4);
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      std::uint8_t* t = &layer.rgba[(static_cast<std::size_t>(y) * n + x) * 4];
+      t[0] = x < n / 2 ? 255 : 0, t[1] = 0, t[2] = x < n / 2 ? 0 : 255, t[3] = 255;
+    }
+  }
+  textured->textures = {layer};
+  for (const render::MeshVertex& vertex : textured->mesh.vertices)
+    textured->mesh.texcoords.push_back({{vertex.position.y < 0.0f ? 0.25f : 0.75f, 0.5f}, 0.0f});
+  const auto count = [&](bool texture) {
+    s.traffic = {v};
+    s.traffic[0].model =
+        texture
+            ? textured
+            : std::make_shared<const model::VehicleModel>(model::default_vehicle(v.vehicle_class));
+    s.traffic[0].size_m = glm::dvec3(s.traffic[0].model->size());
+    s.traffic_lights = {sim::VehicleLights{}};
+    const RgbaImage image = render(spec, s);
+    if (const char* dir = std::getenv("DOWNPOUR_TEST_IMAGES"))
+      testing::write_png(std::string(dir) + (texture ? "/model_textured.png" : "/model_plain.png"),
+                         image);
+    // The red pixels and the blue, and their mean columns.
+    std::array<double, 4> found{};  // red, its mean x, blue, its mean x
+    for (int y = 0; y < image.height / 2; ++y) {
+      for (int x = 0; x < image.width; ++x) {
+        const std::uint8_t* p = &image.pixels[(static_cast<std::size_t>(y) * image.width + x) * 4];
+        if (p[0] > p[1] + 40 && p[0] > p[2] + 40) found[0] += 1.0, found[1] += x;
+        if (p[2] > p[0] + 40 && p[2] > p[1] + 30) found[2] += 1.0, found[3] += x;
+      }
+    }
+    found[1] /= std::max(found[0], 1.0);
+    found[3] /= std::max(found[2], 1.0);
+    return found;
+  };
+  const std::array<double, 4> plain = count(false), painted = count(true);
+  std::printf(
+      "red pixels (mean column), blue pixels (mean column): %.0f (%.0f), %.0f (%.0f) untextured; "
+      "%.0f (%.0f), %.0f (%.0f) with the texture\n",
+      plain[0], plain[1], plain[2], plain[3], painted[0], painted[1], painted[2], painted[3]);
+  // Red on the truck's right (the view's right, seen from behind), blue on its left.
+  EXPECT_GT(painted[0], plain[0] + 500);
+  EXPECT_GT(painted[2], plain[2] + 500);
+  EXPECT_GT(painted[1], painted[3] + 10.0);
 }
 
 // The spray a body stops wets it (sim/spray.hpp), on a dry day too: a silver car 25 m ahead whose

@@ -65,7 +65,9 @@ namespace downpour::render {
   X(kClientDepth, 24, sampler2D, client_depth_tex,                                                 \
     "its depth, the view's reversed-Z (0 the sky or unknown)")                                     \
   X(kSprayMirrorHaze, 25, sampler2D, spray_mirror_haze_tex,                                        \
-    "the spray's haze seen in the road's mirror: r optical depth, g that times distance (m)")
+    "the spray's haze seen in the road's mirror: r optical depth, g that times distance (m)")      \
+  X(kModelTexture, 26, sampler2DArray, model_tex,                                                  \
+    "the model being drawn's base-colour textures, a layer each (sRGB, mipmapped)")
 
 // The per-frame uniform block: X(GLSL type, name, comment). Every field is a vec4 or a mat4, so
 // the C++ struct below has the std140 layout as it is.

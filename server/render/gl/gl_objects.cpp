@@ -134,6 +134,16 @@ Mesh::Mesh(const MeshData& data)
       glVertexArrayAttribBinding(vao, 3 + a, 1);
     }
   }
+  if (!data.texcoords.empty()) {
+    glCreateBuffers(1, ids);
+    texcoords_ = Buffer(ids[0]);
+    glNamedBufferStorage(texcoords_.id(), data.texcoords.size() * sizeof(VertexTexture),
+                         data.texcoords.data(), 0);
+    glVertexArrayVertexBuffer(vao, 3, texcoords_.id(), 0, sizeof(VertexTexture));
+    glEnableVertexArrayAttrib(vao, 6);
+    glVertexArrayAttribFormat(vao, 6, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(vao, 6, 3);
+  }
   if (!data.lanes.empty()) {
     glCreateBuffers(1, ids);
     lanes_ = Buffer(ids[0]);

@@ -125,6 +125,7 @@ class Mesh {
   Buffer ibo_;
   Buffer curvature_;
   Buffer lanes_;
+  Buffer texcoords_;
   GLsizei index_count_ = 0;
 };
 

@@ -2,6 +2,7 @@
 // places; a hand-written .gltf is read in glTF's axes into the vehicle frame's, placed on its rear
 // axle; a cabin's windshield gives the glass's outline; every broken or hostile file is refused
 // with a message that says why, and a 200k-triangle model reads in well under a second.
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
 
+#include "server/encode/png_encoder.hpp"
 #include "server/model/default_models.hpp"
 #include "server/model/gltf_model.hpp"
 #include "server/model/materials.hpp"
@@ -102,6 +104,104 @@ std::string box_gltf(const std::string& material, const std::string& node_name =
          uri + R"("}])" + extra + "}";
 }
 
+// The box with a base-colour texture: a PNG of 2 x 1 pixels, red on the left and blue on the
+// right, its vertices on glTF's -x reading u = 0.25 (red), those on +x u = 0.75 (blue). `png`:
+// the image's bytes in place of that PNG.
+std::string textured_box_gltf(const std::string& material, std::string png = {}) {
+  if (png.empty()) {
+    const std::uint8_t pixels[6] = {255, 0, 0, 0, 0, 255};
+    png = encode::encode_png(pixels, 2, 1, encode::PngFormat::kRgb8, encode::RowOrder::kTopDown);
+  }
+  std::string bytes = box_bytes(0.9f, 1.4f, -1.0f, 3.6f);
+  const float xs[8] = {-1, 1, 1, -1, -1, 1, 1, -1};
+  for (float x : xs) {
+    const float uv[2] = {x < 0.0f ? 0.25f : 0.75f, 0.5f};
+    bytes.append(reinterpret_cast<const char*>(uv), sizeof(uv));
+  }
+  return R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],)"
+         R"("nodes":[{"name":"body","mesh":0}],)"
+         R"("meshes":[{"primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":2},"indices":1,)"
+         R"("material":0}]}],)"
+         R"("materials":[{"name":")" +
+         material +
+         R"(","pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],)"
+         R"("textures":[{"source":0}],)"
+         R"("images":[{"uri":"data:image/png;base64,)" +
+         base64(png) +
+         R"("}],)"
+         R"("accessors":[{"bufferView":0,"componentType":5126,"count":8,"type":"VEC3",)"
+         R"("min":[-1,0,-1],"max":[1,1,1]},)"
+         R"({"bufferView":1,"componentType":5123,"count":36,"type":"SCALAR"},)"
+         R"({"bufferView":2,"componentType":5126,"count":8,"type":"VEC2"}],)"
+         R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":96},)"
+         R"({"buffer":0,"byteOffset":96,"byteLength":72},)"
+         R"({"buffer":0,"byteOffset":168,"byteLength":64}],)"
+         R"("buffers":[{"byteLength":232,"uri":"data:application/octet-stream;base64,)" +
+         base64(bytes) + R"("}]})";
+}
+
+// A base-colour texture is read: decoded, resampled to a layer (kModelTextureSide square, the
+// mean of the pixels each texel covers, in linear light), and each vertex keeps where it reads it.
+TEST(GltfModelTest, ABaseColourTextureIsReadIntoALayer) {
+  const VehicleModel m = read_gltf(textured_box_gltf("Trim"), ModelKind::kVehicle);
+  ASSERT_EQ(m.textures.size(), 1u);
+  ASSERT_EQ(m.mesh.texcoords.size(), m.mesh.vertices.size());
+  constexpr int n = kModelTextureSide;
+  auto texel = [&](int x, int y) {
+    const std::uint8_t* t = &m.textures[0].rgba[(static_cast<std::size_t>(y) * n + x) * 4];
+    return std::array<int, 4>{t[0], t[1], t[2], t[3]};
+  };
+  EXPECT_EQ(texel(n / 4, n / 2), (std::array<int, 4>{255, 0, 0, 255}));
+  EXPECT_EQ(texel(3 * n / 4, n / 2), (std::array<int, 4>{0, 0, 255, 255}));
+  int red = 0, blue = 0;
+  for (std::size_t i = 0; i < m.mesh.vertices.size(); ++i) {
+    const render::VertexTexture& t = m.mesh.texcoords[i];
+    EXPECT_EQ(t.layer, 0.0f);
+    // glTF's -x is the vehicle's right (-y): red there.
+    if (m.mesh.vertices[i].position.y < 0.0f)
+      red += t.uv.x == 0.25f;
+    else
+      blue += t.uv.x == 0.75f;
+  }
+  EXPECT_EQ(red + blue, static_cast<int>(m.mesh.vertices.size()));
+  // A textured trim's colour is the texture's (times white), not the built-in dark trim.
+  EXPECT_EQ(m.mesh.vertices[0].uv.y, pack_trim_colour(1.0, 1.0, 1.0));
+  // Paint keeps the vehicle's colour, times the texture.
+  const VehicleModel paint = read_gltf(textured_box_gltf("Car_Paint"), ModelKind::kVehicle);
+  EXPECT_EQ(paint.mesh.vertices[0].uv.x, material::kBody);
+  EXPECT_EQ(paint.textures.size(), 1u);
+  // Without TEXCOORD_0 the texture is not used.
+  std::string bare = textured_box_gltf("Trim");
+  bare.replace(bare.find(R"(,"TEXCOORD_0":2)"), 15, "");
+  const VehicleModel untextured = read_gltf(bare, ModelKind::kVehicle);
+  EXPECT_TRUE(untextured.textures.empty());
+  EXPECT_TRUE(untextured.mesh.texcoords.empty());
+}
+
+TEST(GltfModelTest, ABadOrOversizedTextureIsRefusedWithAReason) {
+  const auto refusal = [](const std::string& text, const ModelLimits& limits = {}) {
+    try {
+      read_gltf(text, ModelKind::kVehicle, limits);
+    } catch (const ModelError& e) {
+      return std::string(e.what());
+    }
+    return std::string("read");
+  };
+  const std::string damaged = refusal(textured_box_gltf("Trim", "\x89PNG\r\n\x1a\n broken"));
+  const std::string neither = refusal(textured_box_gltf("Trim", "GIF89a"));
+  ModelLimits small;
+  small.max_image_side = 1;
+  const std::string wide = refusal(textured_box_gltf("Trim"), small);
+  ModelLimits few;
+  few.max_image_pixels = 1;
+  const std::string many = refusal(textured_box_gltf("Trim"), few);
+  std::printf("%s\n%s\n%s\n%s\n", damaged.c_str(), neither.c_str(), wide.c_str(), many.c_str());
+  EXPECT_NE(damaged.find("image 0"), std::string::npos);
+  EXPECT_NE(neither.find("neither a JPEG nor a PNG"), std::string::npos);
+  EXPECT_NE(wide.find("over the limit of 1x1"), std::string::npos);
+  EXPECT_NE(many.find("more than 1 pixels"), std::string::npos);
+}
+
 TEST(GltfModelTest, AHandWrittenFileIsReadInTheVehicleFramesAxes) {
   const VehicleModel m = read_gltf(box_gltf("Car_Paint"), ModelKind::kVehicle);
   EXPECT_EQ(m.triangles(), 12u);
@@ -156,6 +256,20 @@ TEST(GltfModelTest, BuffersBesideTheFileAreReadAndNothingElse) {
       std::printf("%s: %s\n", name, e.what());
     }
   }
+  // A texture's image beside the file is read through the same checks.
+  {
+    std::string text = textured_box_gltf("Trim");
+    const std::size_t at = text.find("data:image/png;base64,");
+    const std::size_t end = text.find('"', at);
+    const std::uint8_t pixels[6] = {255, 0, 0, 0, 0, 255};
+    std::ofstream(dir / "red_blue.png", std::ios::binary)
+        << encode::encode_png(pixels, 2, 1, encode::PngFormat::kRgb8, encode::RowOrder::kTopDown);
+    std::ofstream(dir / "textured.gltf") << text.substr(0, at) + "red_blue.png" + text.substr(end);
+    std::ofstream(dir / "escaping_image.gltf")
+        << text.substr(0, at) + "../gltf_beside/red_blue.png" + text.substr(end);
+  }
+  EXPECT_EQ(read_gltf_file(dir / "textured.gltf", ModelKind::kVehicle).textures.size(), 1u);
+  EXPECT_THROW(read_gltf_file(dir / "escaping_image.gltf", ModelKind::kVehicle), ModelError);
   // The same text from memory, with nowhere to look beside it.
   EXPECT_THROW(read_gltf(box_gltf("paint", "body", "box.bin"), ModelKind::kVehicle), ModelError);
   EXPECT_THROW(read_gltf_file(dir / "missing.glb", ModelKind::kVehicle), ModelError);
