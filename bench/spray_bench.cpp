@@ -7,7 +7,8 @@
 // - the smoothing's share: each method's spray pass less the pass without smoothing;
 // - the spray's share of whole frames (no finish between passes, as the server renders): the
 //   frame with the spray less the frame without, frame by frame, median;
-// - the simulation's spray step while driving (median per step).
+// - the simulation's spray step while driving (median per step), and its parcels for the renderer
+//   (the image, classified body or spray; median and p90 per step).
 // Usage: downpour-spray-bench [--frames N] [--seconds S] [--road-mm MM] [--cpu-splat|--gpu-splat]
 #include <chrono>
 #include <cstdio>
@@ -30,7 +31,8 @@ namespace {
 
 // The drive: the ego car behind two trucks, three cars in the next lane ahead, every one at
 // 25 m/s.
-sim::Simulation drive(double seconds, double road_mm, std::vector<double>& spray_step_ms) {
+sim::Simulation drive(double seconds, double road_mm, std::vector<double>& spray_step_ms,
+                      std::vector<double>& spray_image_ms) {
   testing::SprayDrive d;
   d.seconds = seconds;
   d.truck_gap_m = 22.0;
@@ -42,6 +44,7 @@ sim::Simulation drive(double seconds, double road_mm, std::vector<double>& spray
                      {5, 75.0, 1, {4.5, 1.8, 1.5}}};
   return testing::drive(d, [&](const sim::Simulation& s) {
     spray_step_ms.push_back(s.last_advance_timing().spray_ms);
+    spray_image_ms.push_back(s.last_advance_timing().spray_image_ms);
   });
 }
 
@@ -63,8 +66,8 @@ int main(int argc, char** argv) {
   app.add_flag("--gpu-splat", gpu, "the GPU draws the parcels (a GPU's default)");
   CLI11_PARSE(app, argc, argv);
 
-  std::vector<double> step_ms;
-  const sim::Simulation simulation = drive(seconds, road_mm, step_ms);
+  std::vector<double> step_ms, image_ms;
+  const sim::Simulation simulation = drive(seconds, road_mm, step_ms, image_ms);
   const sim::SceneState wet = simulation.state();
   sim::SceneState dry = wet;
   dry.spray.reset();
@@ -73,6 +76,9 @@ int main(int argc, char** argv) {
   out["max_parcels"] = simulation.spray().config().max_particles;
   out["spray_step_ms"] = bench::median(step_ms);
   out["spray_step_p90_ms"] = bench::percentile(step_ms, 0.9);
+  // The parcels for the renderer, classified body or spray (in the step thread's publish).
+  out["spray_image_ms"] = bench::median(image_ms);
+  out["spray_image_p90_ms"] = bench::percentile(image_ms, 0.9);
   const auto& counts = wet.spray->counts;
   out["parcels_by_kind"] = {
       {"mist", counts[0]}, {"small", counts[1]}, {"medium", counts[2]}, {"large", counts[3]}};

@@ -59,9 +59,12 @@ void Simulation::publish() {
     state_.road_water = std::move(image);
     road_image_stale_ = false;
   }
+  const auto t_spray = Clock::now();
   auto spray = std::make_shared<SprayImage>();
   spray_.image(state_.vehicle.position_m, *spray);
   state_.spray = std::move(spray);
+  timing_.spray_image_ms =
+      std::chrono::duration<double, std::milli>(Clock::now() - t_spray).count();
   // Under each tire: front left, front right, rear left, rear right.
   const glm::dmat4 to_world = vehicle_to_world(state_.vehicle);
   for (int t = 0; t < kTires; ++t) {

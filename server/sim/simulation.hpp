@@ -25,9 +25,10 @@ struct AdvanceTiming {
   double water_ms = 0.0;    // the windshield water's sub-steps
   double publish_ms = 0.0;  // the state the renderer reads: the glass's water, the road's, spray
   double surface_ms = 0.0;  // of which: the glass water's bodies, their grid and wet fraction
-  double rain_ms = 0.0;     // the rain in the air: its steps and its copy for the renderer
-  double road_ms = 0.0;     // the water on the road's steps
-  double spray_ms = 0.0;    // the spray's steps
+  double spray_image_ms = 0.0;  // and the spray's parcels for the renderer, body or spray
+  double rain_ms = 0.0;         // the rain in the air: its steps and its copy for the renderer
+  double road_ms = 0.0;         // the water on the road's steps
+  double spray_ms = 0.0;        // the spray's steps
 };
 
 struct SimulationConfig {

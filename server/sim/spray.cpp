@@ -474,7 +474,7 @@ void Spray::step(const std::vector<SpraySource>& sources, glm::dvec3 wind, Spray
   }
 }
 
-void Spray::image(glm::dvec3 origin, SprayImage& out) const {
+void Spray::image(glm::dvec3 origin, SprayImage& out) {
   const SprayConfig& c = config_;
   out.origin_m = origin;
   out.points.clear();
@@ -498,18 +498,19 @@ void Spray::image(glm::dvec3 origin, SprayImage& out) const {
   classify(out);
 }
 
-// Body or spray: neighbours counted in a hash of cells as wide as the neighbour radius (the 27
-// cells around a parcel hold every neighbour), liquid parcels only.
-void Spray::classify(SprayImage& out) const {
+// Body or spray: neighbours counted in a hash of cells twice as wide as the neighbour radius, so
+// that the 8 cells of the 2 x 2 x 2 block nearest a parcel hold every neighbour (27 cells as wide
+// as the radius would be three times the look-ups, each a cache miss), liquid parcels only. The
+// parcels are sorted by bucket into arrays of their own (position and cell), so that a bucket is
+// read in one run; a bucket may hold other cells' parcels (the hash's collisions), which its cell
+// tells apart, so that each neighbour is counted once, for its own cell.
+void Spray::classify(SprayImage& out) {
   const double h = config_.neighbour_radius_m;
   const float h2 = static_cast<float>(h * h);
+  const float inv_side = static_cast<float>(0.5 / h);
   const std::size_t n = out.points.size();
   std::size_t buckets = 64;
   while (buckets < 2 * n) buckets *= 2;
-  auto cell_of = [&](const SprayImage::Point& p) {
-    return glm::ivec3(static_cast<int>(std::floor(p.x / h)), static_cast<int>(std::floor(p.y / h)),
-                      static_cast<int>(std::floor(p.z / h)));
-  };
   auto bucket = [&](glm::ivec3 q) {
     const std::uint64_t key = static_cast<std::uint64_t>(q.x) * 73856093u ^
                               static_cast<std::uint64_t>(q.y) * 19349663u ^
@@ -517,37 +518,49 @@ void Spray::classify(SprayImage& out) const {
     return static_cast<std::size_t>(key & (buckets - 1));
   };
   // Counting sort of the liquid parcels by bucket.
-  std::vector<std::uint32_t> start(buckets + 1, 0), order;
-  order.reserve(n);
-  for (const SprayImage::Point& p : out.points)
-    if (p.kind != SprayKind::kMist) ++start[bucket(cell_of(p)) + 1];
-  for (std::size_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
-  order.resize(start[buckets]);
-  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+  Classified& c = classified_;
+  c.cell.resize(n);
+  c.bucket.resize(n);
+  c.start.assign(buckets + 1, 0);
   for (std::size_t i = 0; i < n; ++i) {
-    if (out.points[i].kind != SprayKind::kMist)
-      order[fill[bucket(cell_of(out.points[i]))]++] = static_cast<std::uint32_t>(i);
-  }
-  for (SprayImage::Point& p : out.points) {
+    const SprayImage::Point& p = out.points[i];
     if (p.kind == SprayKind::kMist) continue;
-    const glm::ivec3 q = cell_of(p);
-    // The 27 cells' buckets, each once (two cells may share one).
-    std::array<std::size_t, 27> near{};
-    int count = 0;
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) near[count++] = bucket(q + glm::ivec3(dx, dy, dz));
-    std::sort(near.begin(), near.end());
-    const auto end = std::unique(near.begin(), near.end());
+    c.cell[i] = glm::ivec3(static_cast<int>(std::floor(p.x * inv_side)),
+                           static_cast<int>(std::floor(p.y * inv_side)),
+                           static_cast<int>(std::floor(p.z * inv_side)));
+    c.bucket[i] = static_cast<std::uint32_t>(bucket(c.cell[i]));
+    ++c.start[c.bucket[i] + 1];
+  }
+  for (std::size_t b = 0; b < buckets; ++b) c.start[b + 1] += c.start[b];
+  c.sorted.resize(c.start[buckets]);
+  c.fill.assign(c.start.begin(), c.start.end() - 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const SprayImage::Point& p = out.points[i];
+    if (p.kind != SprayKind::kMist)
+      c.sorted[c.fill[c.bucket[i]]++] = {p.x, p.y, p.z, c.cell[i], static_cast<std::uint32_t>(i)};
+  }
+  // In the sorted order: a cell's parcels one after another look up the same cells.
+  const int enough = config_.body_neighbours;
+  for (const Classified::Entry& e : c.sorted) {
+    SprayImage::Point& p = out.points[e.index];
+    const glm::ivec3 q = e.cell;
+    // The block's lower corner: towards the nearer neighbour cell on each axis.
+    const glm::ivec3 lo(q.x - (p.x * inv_side - static_cast<float>(q.x) < 0.5f ? 1 : 0),
+                        q.y - (p.y * inv_side - static_cast<float>(q.y) < 0.5f ? 1 : 0),
+                        q.z - (p.z * inv_side - static_cast<float>(q.z) < 0.5f ? 1 : 0));
     int found = -1;  // the parcel itself is among them
-    for (auto b = near.begin(); b != end && found < config_.body_neighbours; ++b) {
-      for (std::uint32_t k = start[*b]; k < start[*b + 1]; ++k) {
-        const SprayImage::Point& o = out.points[order[k]];
+    for (int k8 = 0; k8 < 8 && found < enough; ++k8) {
+      const glm::ivec3 cell = lo + glm::ivec3(k8 & 1, k8 >> 1 & 1, k8 >> 2);
+      const std::size_t b = bucket(cell);
+      // (In a dense sheet a cell holds hundreds: enough found, the rest need not be.)
+      for (std::uint32_t k = c.start[b]; k < c.start[b + 1] && found < enough; ++k) {
+        const Classified::Entry& o = c.sorted[k];
+        if (o.cell != cell) continue;
         const float ex = o.x - p.x, ey = o.y - p.y, ez = o.z - p.z;
         found += ex * ex + ey * ey + ez * ez <= h2;
       }
     }
-    p.body = found >= config_.body_neighbours;
+    p.body = found >= enough;
     // A body is a sheet: its parcels overlap, so that its surface is one.
     if (p.body)
       p.liquid_radius_m = std::max(p.liquid_radius_m, static_cast<float>(kSheetRadius * h));

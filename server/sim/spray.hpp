@@ -224,7 +224,7 @@ class Spray {
   double body_wetness(std::uint32_t key, glm::dvec3 size_m) const;
   double airborne_m3() const;
   const SprayConfig& config() const { return config_; }
-  void image(glm::dvec3 origin_m, SprayImage& out) const;
+  void image(glm::dvec3 origin_m, SprayImage& out);
   double radius_m(const SprayParticle& p) const {
     const int k = static_cast<int>(p.kind);
     return config_.radius_m[k] + config_.spread_mps[k] * p.age_s;
@@ -233,7 +233,7 @@ class Spray {
  private:
   struct Pose;
   void emit(const Pose& source, SprayGround& ground);
-  void classify(SprayImage& out) const;
+  void classify(SprayImage& out);
   // The air dragged along by a vehicle at p, and how strong its wake is there (0-1).
   glm::dvec3 wake(const Pose& source, glm::dvec3 p, double* strength) const;
 
@@ -267,6 +267,18 @@ class Spray {
   std::vector<std::int16_t> grid_head_;    // per cell, its first entry (-1: none)
   std::vector<std::int16_t> grid_target_;  // per entry, its target and the next entry in its cell
   std::vector<std::int16_t> grid_next_;
+  // classify()'s buffers, kept from image to image (no allocation once they have grown).
+  struct Classified {
+    struct Entry {
+      float x, y, z;
+      glm::ivec3 cell;
+      std::uint32_t index;  // in the image's points
+    };
+    std::vector<glm::ivec3> cell;
+    std::vector<std::uint32_t> bucket, start, fill;
+    std::vector<Entry> sorted;
+  };
+  Classified classified_;
   // Each body's caught water (m^3) by key, sorted.
   std::vector<std::pair<std::uint32_t, double>> body_water_;
   std::array<std::array<Drag, kDragSteps + 1>, kSprayKinds> drag_{};

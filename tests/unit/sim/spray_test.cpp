@@ -344,6 +344,39 @@ TEST(SprayTest, AVehicleStopsTheSprayThatMeetsItAndGetsWet) {
   EXPECT_EQ(truck_wet, 0.0);
 }
 
+// Body or spray (the image's classification, a hash of cells) is what counting every pair gives: a
+// liquid parcel with at least body_neighbours others within neighbour_radius_m is body. Behind a
+// truck on a puddled road for 2 s.
+TEST(SprayTest, BodyOrSprayIsWhatCountingEveryPairGives) {
+  EvenGround ground(kPuddleM);
+  Drive drive;
+  drive.add(1, 300.0, 25.0, kTruck);
+  drive.run(2.0, ground);
+  SprayImage image;
+  drive.spray.image(glm::dvec3(0.0), image);
+  const SprayConfig& c = drive.spray.config();
+  const float h2 = static_cast<float>(c.neighbour_radius_m * c.neighbour_radius_m);
+  int body = 0, liquid = 0, wrong = 0;
+  for (const SprayImage::Point& p : image.points) {
+    if (p.kind == SprayKind::kMist) continue;
+    ++liquid;
+    int near = -1;  // itself
+    for (const SprayImage::Point& o : image.points) {
+      if (o.kind == SprayKind::kMist) continue;
+      const float ex = o.x - p.x, ey = o.y - p.y, ez = o.z - p.z;
+      near += ex * ex + ey * ey + ez * ez <= h2;
+    }
+    const bool is_body = near >= c.body_neighbours;
+    body += is_body;
+    wrong += is_body != p.body;
+  }
+  std::printf("%d liquid parcels, %d of them body; %d classified otherwise than by every pair\n",
+              liquid, body, wrong);
+  EXPECT_GT(body, 100);
+  EXPECT_GT(liquid - body, 100);
+  EXPECT_EQ(wrong, 0);
+}
+
 // What a body caught runs off and dries once the spray stops: with no spray, a wet body's water
 // keeps exp(-t / body_dry_s) of itself.
 TEST(SprayTest, AWetBodyDries) {
