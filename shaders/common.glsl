@@ -115,6 +115,19 @@ float fresnel_water(float cos_theta) {
   return 0.5 * a * a * (1.0 + b * b);
 }
 
+// The light a cloud of droplets (the spray's haze) sends towards the eye where the screen's uv sees
+// it at distance z along the view's axis: the droplets' light from the sky and the scene (`light`,
+// linear) and the lamps' where their beams pass through the cloud's point. The frame's camera: the
+// view's, or the road mirror's (its rays, unfolded at the road, run through the real world).
+vec3 haze_radiance(vec2 uv, float z, vec3 light) {
+  vec4 far = frame.inv_view_proj * vec4(uv * 2.0 - 1.0, 0.5, 1.0);
+  vec4 centre = frame.inv_view_proj * vec4(0.0, 0.0, 0.5, 1.0);
+  vec3 dir = normalize(far.xyz / far.w - frame.camera_pos.xyz);
+  vec3 ahead = normalize(centre.xyz / centre.w - frame.camera_pos.xyz);
+  vec3 p = frame.camera_pos.xyz + dir * (z / max(dot(dir, ahead), 0.1));
+  return light + lamps_scattered(p, -dir);
+}
+
 // Display transform: a gentle shoulder, then gamma 2 (sqrt: far cheaper than pow on llvmpipe).
 vec3 to_display(vec3 c) {
   c = c / (1.0 + 0.15 * c);

@@ -21,10 +21,5 @@ void main() {
   float scene = u_near / max(textureLod(view_depth_tex, v_uv, 0.0).r, 1e-12);
   float alpha = (1.0 - exp(-h.x)) * clamp((scene - z) / u_soft_m + 0.5, 0.0, 1.0);
   // And the lamps' (a beam through the mist glows), at the cloud's mean distance along the ray.
-  vec4 far = frame.inv_view_proj * vec4(v_uv * 2.0 - 1.0, 0.5, 1.0);
-  vec4 centre = frame.inv_view_proj * vec4(0.0, 0.0, 0.5, 1.0);
-  vec3 dir = normalize(far.xyz / far.w - frame.camera_pos.xyz);
-  vec3 ahead = normalize(centre.xyz / centre.w - frame.camera_pos.xyz);
-  vec3 p = frame.camera_pos.xyz + dir * (z / max(dot(dir, ahead), 0.1));
-  out_colour = vec4(to_display(u_light + lamps_scattered(p, -dir)) * alpha, alpha);
+  out_colour = vec4(to_display(haze_radiance(v_uv, z, u_light)) * alpha, alpha);
 }

@@ -3,7 +3,7 @@
 // (spray_haze_composite.frag): the droplets' light, the sky's and the scene's and the lamps' where
 // their beams pass, times their coverage 1 - exp(-tau), premultiplied, at the clouds' mean
 // distance (reversed-Z), so that the mirror's nearer surfaces hide it. The frame block holds the
-// mirrored camera: its rays, unfolded at the road, run through the real world.
+// mirrored camera (haze_radiance, common.glsl).
 #include "common.glsl"
 in vec2 v_uv;
 uniform vec3 u_light;  // linear: the sky's and the scene's
@@ -14,11 +14,6 @@ void main() {
   if (h.x <= 1e-3) discard;
   float z = h.y / h.x;
   float alpha = 1.0 - exp(-h.x);
-  vec4 far = frame.inv_view_proj * vec4(v_uv * 2.0 - 1.0, 0.5, 1.0);
-  vec4 centre = frame.inv_view_proj * vec4(0.0, 0.0, 0.5, 1.0);
-  vec3 dir = normalize(far.xyz / far.w - frame.camera_pos.xyz);
-  vec3 ahead = normalize(centre.xyz / centre.w - frame.camera_pos.xyz);
-  vec3 p = frame.camera_pos.xyz + dir * (z / max(dot(dir, ahead), 0.1));
   gl_FragDepth = u_near / max(z, u_near);
-  out_colour = vec4(to_display(u_light + lamps_scattered(p, -dir)) * alpha, alpha);
+  out_colour = vec4(to_display(haze_radiance(v_uv, z, u_light)) * alpha, alpha);
 }

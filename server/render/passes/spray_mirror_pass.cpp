@@ -63,10 +63,8 @@ void SprayMirrorPass::execute(const FrameContext& frame, const FrameResources& r
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTextureSubImage2D(haze_.id(), 0, 0, 0, width, height, GL_RG, GL_FLOAT, pixels_.data());
   glBindTextureUnit(texture_unit::kSprayMirrorHaze, haze_.id());
-  // The light the droplets scatter, as the view's haze (SprayHazeOverPass).
-  const Atmosphere& atm = frame.atmosphere;
   program_.use();
-  u_light_.set(glm::mix(atm.sky_horizon, atm.ambient, 0.4f) * 0.95f + atm.sun_radiance * 0.05f);
+  u_light_.set(spray_haze_light(frame.atmosphere));
   u_near_.set(camera.near_m);
   glBindVertexArray(vao_.id());
   glDrawArrays(GL_TRIANGLES, 0, 3);

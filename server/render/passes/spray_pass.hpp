@@ -196,6 +196,9 @@ class SprayHazePass final : public Pass {
   std::vector<glm::vec4> packed_;
 };
 
+// The light the spray's droplets scatter from the sky and the scene (its haze, and its mirror's).
+glm::vec3 spray_haze_light(const Atmosphere& atm);
+
 class SprayHazeOverPass final : public Pass {
  public:
   SprayHazeOverPass(SharedResources& shared, const SprayPass& spray);

@@ -65,6 +65,12 @@ void SprayHazePass::execute(const FrameContext& frame, const FrameResources& res
   glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, static_cast<GLsizei>(spray_.clouds().size()));
 }
 
+// The light the droplets scatter: the sky's and the scene's around them, as the rain's. (Linear:
+// the shaders add the lamps' light where their beams pass, then encode it.)
+glm::vec3 spray_haze_light(const Atmosphere& atm) {
+  return glm::mix(atm.sky_horizon, atm.ambient, 0.4f) * 0.95f + atm.sun_radiance * 0.05f;
+}
+
 SprayHazeOverPass::SprayHazeOverPass(SharedResources&, const SprayPass& spray)
     : spray_(spray),
       program_("spray_runs.vert", "spray_haze_composite.frag"),
@@ -73,13 +79,8 @@ SprayHazeOverPass::SprayHazeOverPass(SharedResources&, const SprayPass& spray)
       u_soft_(program_.uniform("u_soft_m")) {}
 
 void SprayHazeOverPass::execute(const FrameContext& frame, const FrameResources&) {
-  // The light the droplets scatter: the sky's and the scene's around them, as the rain's.
-  const Atmosphere& atm = frame.atmosphere;
-  // (Linear: the shader adds the lamps' light where their beams pass, then encodes it.)
-  const glm::vec3 light =
-      glm::mix(atm.sky_horizon, atm.ambient, 0.4f) * 0.95f + atm.sun_radiance * 0.05f;
   program_.use();
-  u_light_.set(light);
+  u_light_.set(spray_haze_light(frame.atmosphere));
   u_near_.set(frame.camera.near_m);
   u_soft_.set(kHazeSoftM);
   runs_.draw(spray_.runs());
