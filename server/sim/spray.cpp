@@ -210,7 +210,11 @@ void Spray::emit(const Pose& v, SprayGround& ground) {
     const double got = under.beyond ? wanted : ground.take(at, wanted);
     (under.beyond ? ledger_.beyond_m3 : ledger_.taken_m3) += got;
     const double share = got / wanted;
-    for (std::size_t i = first; i < particles_.size(); ++i) particles_[i].volume_m3 *= share;
+    for (std::size_t i = first; i < particles_.size(); ++i) {
+      SprayParticle& p = particles_[i];
+      p.volume_m3 *= share;
+      p.gathered_m = static_cast<float>(std::cbrt(3.0 * p.volume_m3 / (4.0 * M_PI)));
+    }
   }
 }
 
@@ -488,8 +492,8 @@ void Spray::image(glm::dvec3 origin, SprayImage& out) {
     // / (4/3 pi R^3), extinction n pi d^2 / 2, through the centre (2R): 9 V / (2 pi d R^2).
     const double d = c.diameter_mm[k] * 1e-3;
     const double haze = 9.0 * p.volume_m3 / (2.0 * M_PI * d * size * size);
-    const double gathered = std::cbrt(3.0 * p.volume_m3 / (4.0 * M_PI));
-    const double liquid = p.kind == SprayKind::kMist ? 0.0 : std::min(gathered, size);
+    const double liquid =
+        p.kind == SprayKind::kMist ? 0.0 : std::min(static_cast<double>(p.gathered_m), size);
     out.points.push_back({static_cast<float>(r.x), static_cast<float>(r.y), static_cast<float>(r.z),
                           static_cast<float>(size), static_cast<float>(liquid),
                           static_cast<float>(haze), p.kind, p.splash, false});

@@ -134,7 +134,8 @@ struct SprayParticle {
   float age_s = 0.0f;
   std::uint32_t source = 0;  // the key of the vehicle that threw it
   SprayKind kind = SprayKind::kSmall;
-  bool splash = false;  // from a puddle splash (else from the tire)
+  bool splash = false;      // from a puddle splash (else from the tire)
+  float gathered_m = 0.0f;  // the radius of its water gathered into one sphere (set at its birth)
 };
 
 // What the spray asks of the road's water: the state and depth under a tire, and water taken and
