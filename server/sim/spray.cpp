@@ -253,16 +253,16 @@ void Spray::find_targets(const std::vector<SpraySource>& sources, std::size_t fi
     const glm::dvec2 lo = (glm::dvec2(centre) - reach - grid_origin_) / kGridCell_m;
     const glm::dvec2 hi = (glm::dvec2(centre) + reach - grid_origin_) / kGridCell_m;
     if (hi.x < 0.0 || hi.y < 0.0 || lo.x >= kGridSide || lo.y >= kGridSide) continue;
-    const auto index = static_cast<std::int16_t>(targets_.size());
+    const auto index = static_cast<std::int32_t>(targets_.size());
     targets_.push_back(t);
     for (int y = std::max(0, static_cast<int>(lo.y));
          y <= std::min(kGridSide - 1, static_cast<int>(hi.y)); ++y) {
       for (int x = std::max(0, static_cast<int>(lo.x));
            x <= std::min(kGridSide - 1, static_cast<int>(hi.x)); ++x) {
-        std::int16_t& head = grid_head_[static_cast<std::size_t>(y) * kGridSide + x];
+        std::int32_t& head = grid_head_[static_cast<std::size_t>(y) * kGridSide + x];
         grid_target_.push_back(index);
         grid_next_.push_back(head);
-        head = static_cast<std::int16_t>(grid_target_.size() - 1);
+        head = static_cast<std::int32_t>(grid_target_.size() - 1);
       }
     }
   }
@@ -273,7 +273,7 @@ Spray::Target* Spray::target_at(glm::dvec3 p, std::uint32_t source) {
   if (!(g.x >= 0.0 && g.y >= 0.0 && g.x < kGridSide && g.y < kGridSide)) return nullptr;
   const std::size_t cell =
       static_cast<std::size_t>(static_cast<int>(g.y)) * kGridSide + static_cast<int>(g.x);
-  for (std::int16_t e = grid_head_[cell]; e >= 0; e = grid_next_[static_cast<std::size_t>(e)]) {
+  for (std::int32_t e = grid_head_[cell]; e >= 0; e = grid_next_[static_cast<std::size_t>(e)]) {
     Target& t = targets_[static_cast<std::size_t>(grid_target_[static_cast<std::size_t>(e)])];
     if (t.key == source) continue;
     const glm::dvec2 d = glm::dvec2(p) - t.centre;

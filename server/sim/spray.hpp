@@ -265,9 +265,9 @@ class Spray {
   SprayConfig config_;
   std::vector<Target> targets_;
   glm::dvec2 grid_origin_{0.0};
-  std::vector<std::int16_t> grid_head_;    // per cell, its first entry (-1: none)
-  std::vector<std::int16_t> grid_target_;  // per entry, its target and the next entry in its cell
-  std::vector<std::int16_t> grid_next_;
+  std::vector<std::int32_t> grid_head_;    // per cell, its first entry (-1: none)
+  std::vector<std::int32_t> grid_target_;  // per entry, its target and the next entry in its cell
+  std::vector<std::int32_t> grid_next_;
   // classify()'s buffers, kept from image to image (no allocation once they have grown).
   struct Classified {
     struct Entry {
