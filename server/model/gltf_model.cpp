@@ -151,6 +151,9 @@ bool write_file(std::string* err, const std::string&, const std::vector<unsigned
 // material takes as its base colour, with their size checked first (encode/image_decoder.hpp).
 bool keep_image(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
                 const unsigned char* bytes, int size, void*) {
+  // An image in a buffer view: tinygltf hands over the view's range unchecked against its buffer;
+  // the reader takes those bytes itself, checked (Reader::image_bytes).
+  if (image->bufferView >= 0) return true;
   image->image.assign(bytes, bytes + std::max(size, 0));
   image->width = image->height = image->component = 0;
   return true;
@@ -500,6 +503,22 @@ class Reader {
     }
   }
 
+  // An image's file bytes: kept by keep_image, or its buffer view's, within its buffer.
+  std::string_view image_bytes(const tinygltf::Image& image, int index) const {
+    if (image.bufferView < 0)
+      return {reinterpret_cast<const char*>(image.image.data()), image.image.size()};
+    const std::string what = "image " + std::to_string(index);
+    if (static_cast<std::size_t>(image.bufferView) >= m_.bufferViews.size())
+      throw ModelError(what + " names no buffer view");
+    const tinygltf::BufferView& v = m_.bufferViews[image.bufferView];
+    if (v.buffer < 0 || static_cast<std::size_t>(v.buffer) >= m_.buffers.size())
+      throw ModelError(what + "'s buffer view has no buffer");
+    const std::vector<unsigned char>& data = m_.buffers[v.buffer].data;
+    if (v.byteOffset > data.size() || v.byteLength > data.size() - v.byteOffset)
+      throw ModelError(what + "'s buffer view lies outside its buffer");
+    return {reinterpret_cast<const char*>(data.data() + v.byteOffset), v.byteLength};
+  }
+
   // The model's layer for glTF texture t: its image decoded and resampled the first time.
   int layer_of(int t) {
     if (static_cast<std::size_t>(t) >= m_.textures.size())
@@ -511,12 +530,10 @@ class Reader {
     if (static_cast<int>(out_.textures.size()) >= limits_.max_textures)
       throw ModelError("the model has more than " + std::to_string(limits_.max_textures) +
                        " base-colour textures");
-    const std::vector<unsigned char>& bytes = m_.images[source].image;
+    const std::string_view bytes = image_bytes(m_.images[source], source);
     encode::BgrxPixels pixels;
     try {
-      pixels = encode::decode_bgrx_up_to(
-          std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
-          limits_.max_image_side);
+      pixels = encode::decode_bgrx_up_to(bytes, limits_.max_image_side);
     } catch (const encode::DecodeError& e) {
       throw ModelError("image " + std::to_string(source) + ": " + e.what());
     }

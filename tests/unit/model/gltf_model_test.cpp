@@ -200,6 +200,17 @@ TEST(GltfModelTest, ABadOrOversizedTextureIsRefusedWithAReason) {
   EXPECT_NE(neither.find("neither a JPEG nor a PNG"), std::string::npos);
   EXPECT_NE(wide.find("over the limit of 1x1"), std::string::npos);
   EXPECT_NE(many.find("more than 1 pixels"), std::string::npos);
+  // An image in a buffer view that runs past its buffer (tinygltf passes such a range on
+  // unchecked): refused, nothing read beyond the buffer.
+  std::string viewed = textured_box_gltf("Trim");
+  const std::size_t at = viewed.find(R"({"uri":"data:image/png;base64,)");
+  const std::size_t end = viewed.find('}', at);
+  viewed.replace(at, end - at + 1, R"({"bufferView":3,"mimeType":"image/png"})");
+  const std::size_t views = viewed.find(R"({"buffer":0,"byteOffset":168,"byteLength":64})");
+  viewed.insert(views + 45, R"(,{"buffer":0,"byteOffset":200,"byteLength":1000000})");
+  const std::string outside = refusal(viewed);
+  std::printf("%s\n", outside.c_str());
+  EXPECT_NE(outside.find("outside its buffer"), std::string::npos);
 }
 
 TEST(GltfModelTest, AHandWrittenFileIsReadInTheVehicleFramesAxes) {
