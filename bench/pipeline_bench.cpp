@@ -113,6 +113,9 @@ json measure_stages(const sim::Scenario& scenario, const sim::ViewSpec& spec, in
   warm(simulation, scenario, warm_s);
   std::vector<double> step_ms, water_ms, map_ms, surface_ms, rain_field_ms, road_water_ms,
       render_ms, readback_ms, encode_ms, frame_ms, cpu_ms;
+  // Each pass's call on the render thread, unfinished: its own CPU work, and where it waits for
+  // llvmpipe (a pass that reads what the last ones drew waits for their rasterizing).
+  std::map<std::string, std::vector<double>> call_ms;
   std::vector<std::uint8_t> pixels;
   const double dt = 1.0 / scenario.fps;
   constexpr int kWarmup = 3;  // the first frames compile shader variants
@@ -124,6 +127,9 @@ json measure_stages(const sim::Scenario& scenario, const sim::ViewSpec& spec, in
     const auto t1 = Clock::now();
     const render::PendingReadback pending = renderer->render(*targets, 0, spec, simulation.state());
     const auto t2 = Clock::now();
+    if (i >= kWarmup) {
+      for (const render::PassTiming& t : renderer->last_pass_timings()) call_ms[t.name].push_back(t.ms);
+    }
     renderer->finish(pending, pixels);
     const auto t3 = Clock::now();
     const std::string jpeg =
@@ -158,6 +164,9 @@ json measure_stages(const sim::Scenario& scenario, const sim::ViewSpec& spec, in
   j["render_thread_ms"] = median(frame_ms);  // render + readback
   j["encode_ms"] = median(encode_ms);
   j["cpu_ms"] = median(cpu_ms);  // all of a frame's work, on every thread
+  json calls;
+  for (const auto& [name, ms] : call_ms) calls[name] = median(ms);
+  j["pass_call_ms"] = calls;
   j["load"] = {{"metaballs", water.metaballs.size()},
                {"drops", water.drops},
                {"particles", water.particles},

@@ -15,10 +15,11 @@ namespace {
 std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
 // The size a picture must have: exactly width x height (a view's), or, with `up_to`, at most
-// that each way (a model's texture).
+// that each way and at most max_pixels in all (a model's texture).
 struct Expect {
   int width = 0, height = 0;
   bool up_to = false;
+  std::size_t max_pixels = 0;
 };
 
 // Why a picture of w x h is not as expected; empty if it is.
@@ -27,6 +28,9 @@ std::string size_error(const char* kind, int w, int h, Expect e) {
     if (w < 1 || h < 1 || w > e.width || h > e.height)
       return std::string("the ") + kind + " is " + size_text(w, h) + ", over the limit of " +
              size_text(e.width, e.height);
+    if (static_cast<std::size_t>(w) * static_cast<std::size_t>(h) > e.max_pixels)
+      return std::string("the ") + kind + " is " + size_text(w, h) + ", over the " +
+             std::to_string(e.max_pixels) + " pixels left to the model";
     return {};
   }
   if (w != e.width || h != e.height)
@@ -178,8 +182,8 @@ BgrxPixels decode_bgrx(std::string_view bytes, int width, int height) {
   throw DecodeError(bytes.empty() ? "empty" : "neither a JPEG nor a PNG");
 }
 
-BgrxPixels decode_bgrx_up_to(std::string_view bytes, int max_side) {
-  const Expect expect{max_side, max_side, true};
+BgrxPixels decode_bgrx_up_to(std::string_view bytes, int max_side, std::size_t max_pixels) {
+  const Expect expect{max_side, max_side, true, max_pixels};
   if (is_jpeg(bytes)) return decode_jpeg(bytes, expect);
   if (is_png(bytes)) return decode_png_bgrx(bytes, expect);
   throw DecodeError(bytes.empty() ? "empty" : "neither a JPEG nor a PNG");

@@ -39,8 +39,9 @@ bool is_png(std::string_view bytes);
 // A JPEG or PNG (grey, RGB, palette, with or without alpha; 16-bit channels are taken to 8) of
 // exactly width x height.
 BgrxPixels decode_bgrx(std::string_view bytes, int width, int height);
-// The same of any size up to max_side x max_side (a model's texture).
-BgrxPixels decode_bgrx_up_to(std::string_view bytes, int max_side);
+// The same of any size up to max_side x max_side and max_pixels in all (a model's texture): the
+// size is checked from the header, before any pixel is decoded.
+BgrxPixels decode_bgrx_up_to(std::string_view bytes, int max_side, std::size_t max_pixels);
 // A PNG of one 16-bit grey channel (no other kind: a depth must not be rounded or converted), of
 // exactly width x height, its values as stored.
 Grey16Pixels decode_png_grey16(std::string_view bytes, int width, int height);

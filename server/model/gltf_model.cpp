@@ -533,14 +533,13 @@ class Reader {
     const std::string_view bytes = image_bytes(m_.images[source], source);
     encode::BgrxPixels pixels;
     try {
-      pixels = encode::decode_bgrx_up_to(bytes, limits_.max_image_side);
+      // What the model's images may still hold, checked from the image's header.
+      pixels = encode::decode_bgrx_up_to(bytes, limits_.max_image_side,
+                                         limits_.max_image_pixels - image_pixels_);
     } catch (const encode::DecodeError& e) {
       throw ModelError("image " + std::to_string(source) + ": " + e.what());
     }
     image_pixels_ += static_cast<std::size_t>(pixels.width) * pixels.height;
-    if (image_pixels_ > limits_.max_image_pixels)
-      throw ModelError("the model's images hold more than " +
-                       std::to_string(limits_.max_image_pixels) + " pixels");
     out_.textures.push_back(to_layer(pixels));
     const int layer = static_cast<int>(out_.textures.size()) - 1;
     layers_[source] = layer;

@@ -79,9 +79,7 @@ FrameBlock make_block(const FrameContext& f, const WaterBlock& water, const Lamp
   b.overcast = f.atmosphere.overcast;
   b.wetness = f.atmosphere.wetness;
   b.rain_rate_mm_h = static_cast<float>(f.scene.weather.rain_rate_mm_h);
-  const float wind_dir = glm::radians(static_cast<float>(f.scene.weather.wind_direction_deg));
-  b.wind = glm::vec4(std::cos(wind_dir), std::sin(wind_dir), 0.0f, 0.0f) *
-           static_cast<float>(f.scene.weather.wind_speed_mps);
+  b.wind = glm::vec4(glm::vec3(sim::wind_velocity(f.scene.weather)), 0.0f);
   // (In the reflection's own frame, view_proj is already mirrored: the road reads these only in
   // the view's.)
   b.mirror_view_proj = b.view_proj * water.mirror.matrix;

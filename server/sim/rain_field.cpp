@@ -198,9 +198,7 @@ void RainField::step(double dt_s, double end_s, const Weather& weather,
   if (drops_.empty()) return;
 
   const glm::dvec3 fall = fall_direction(weather, vehicle);
-  const double wind_dir = weather.wind_direction_deg * M_PI / 180.0;
-  const glm::dvec3 wind(weather.wind_speed_mps * std::cos(wind_dir),
-                        weather.wind_speed_mps * std::sin(wind_dir), 0.0);
+  const glm::dvec3 wind = wind_velocity(weather);
   const double half_length = 0.5 * config_.length_m, half_width = 0.5 * config_.width_m;
   namespace body = car_body;
   const glm::dvec3 car_middle =
@@ -264,9 +262,7 @@ void RainField::publish(RainState* out) const {
   out->box_half_m =
       glm::vec3(0.5 * config_.length_m, 0.5 * config_.width_m, 0.5 * config_.height_m);
   out->fall_direction = glm::vec3(fall_direction(weather_, vehicle_));
-  const double wind_dir = weather_.wind_direction_deg * M_PI / 180.0;
-  out->wind_mps = glm::vec3(weather_.wind_speed_mps * std::cos(wind_dir),
-                            weather_.wind_speed_mps * std::sin(wind_dir), 0.0f);
+  out->wind_mps = glm::vec3(wind_velocity(weather_));
   out->drops.resize(drops_.size());
   for (std::size_t i = 0; i < drops_.size(); ++i) {
     const RainDrop& d = drops_[i];

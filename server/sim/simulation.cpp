@@ -19,11 +19,6 @@ SimulationConfig with_spray_step(SimulationConfig config) {
   return config;
 }
 
-glm::dvec3 wind_velocity(const Weather& w) {
-  const double dir = w.wind_direction_deg * M_PI / 180.0;
-  return {w.wind_speed_mps * std::cos(dir), w.wind_speed_mps * std::sin(dir), 0.0};
-}
-
 }  // namespace
 
 Simulation::Simulation(std::uint64_t seed, const Update& initial, SimulationConfig config)

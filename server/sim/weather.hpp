@@ -15,6 +15,8 @@
 #include <string_view>
 #include <type_traits>
 
+#include <glm/vec3.hpp>
+
 namespace downpour::sim {
 
 // How a scenario carries a field between two keyframes a and b at fraction u:
@@ -80,6 +82,12 @@ inline constexpr std::array kWeatherFields = {
     DOWNPOUR_WEATHER_FIELDS(DOWNPOUR_WEATHER_ROW)
 #undef DOWNPOUR_WEATHER_ROW
 };
+
+// The wind's velocity (m/s, world, z 0): wind_speed_mps towards wind_direction_deg.
+inline glm::dvec3 wind_velocity(const Weather& w) {
+  const double dir = w.wind_direction_deg * M_PI / 180.0;
+  return {w.wind_speed_mps * std::cos(dir), w.wind_speed_mps * std::sin(dir), 0.0};
+}
 
 // From angle a towards b the shorter way round (degrees), at fraction u; the result is not
 // wrapped. Scenarios carry the vehicle's rotation this way too.
