@@ -27,8 +27,10 @@ struct RenderSession::Impl {
   std::shared_ptr<const sim::GlassWaterSurface> surface_shown;
   // The world outside the glass, shared by the session's views (made on first use).
   std::unique_ptr<EnvironmentProbe> environment;
-  // The road's water window on the GPU and the image it shows (held, so that its address names it).
-  Texture road_water;
+  // The road's water window on the GPU, in turn in three textures, and the image the current one
+  // shows (held, so that its address names it).
+  std::array<Texture, 3> road_water;
+  std::size_t road_current = 0;
   int road_cells = 0, road_rings = 0;
   std::shared_ptr<const sim::RoadWaterImage> road_shown;
   bool road_dry_shown = false;
@@ -49,8 +51,8 @@ struct RenderSession::Impl {
   // the step publishes one per tick), bound to its texture buffers.
   void upload_glass_surface(std::shared_ptr<const sim::GlassWaterSurface> surface);
   // The road water rings brought up to the frame's: a whole upload for each new image (one per
-  // road step: 4 rings of 64 x 64 cells, two half floats each).
-  void upload_road_water(const std::shared_ptr<const sim::RoadWaterImage>& image);
+  // road step: 4 rings of 64 x 64 cells, two half floats each); the texture that holds them.
+  GLuint upload_road_water(const std::shared_ptr<const sim::RoadWaterImage>& image);
   // A view's client picture brought up to the frame's (black before the first), its depth made
   // reversed-Z for a camera whose near plane is near_m, bound to their units (kClientImage,
   // kClientDepth).

@@ -187,8 +187,7 @@ struct Renderer::Impl {
         break;
       }
       case Resource::kRoadWater:
-        session.upload_road_water(f.scene.road_water);
-        texture = session.road_water.id();
+        texture = session.upload_road_water(f.scene.road_water);
         break;
       case Resource::kLampMap:
         texture = passes.lamp_map->texture();
