@@ -150,6 +150,9 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
   }
   Sized& sized = this->sized(width, height);
   RainLayer& layer = sized.layer;
+  // The passes drawn so far go to llvmpipe's rasterizer threads now, rather than wait in its bins
+  // while this thread builds the layer (some 3.5 ms at 640x360): the cores share the two.
+  glFlush();
   const auto t0 = std::chrono::steady_clock::now();
   drawn_.streaks = layer.build(rain, in, width, height);
   drawn_.layer_ms =
