@@ -128,7 +128,8 @@ json measure_stages(const sim::Scenario& scenario, const sim::ViewSpec& spec, in
     const render::PendingReadback pending = renderer->render(*targets, 0, spec, simulation.state());
     const auto t2 = Clock::now();
     if (i >= kWarmup) {
-      for (const render::PassTiming& t : renderer->last_pass_timings()) call_ms[t.name].push_back(t.ms);
+      for (const render::PassTiming& t : renderer->last_pass_timings())
+        call_ms[t.name].push_back(t.ms);
     }
     renderer->finish(pending, pixels);
     const auto t3 = Clock::now();

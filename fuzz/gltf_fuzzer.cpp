@@ -52,7 +52,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   require(m.mesh.texcoords.empty() == m.textures.empty());
   require(m.mesh.texcoords.empty() || m.mesh.texcoords.size() == n);
   for (const ModelTexture& t : m.textures)
-    require(t.rgba.size() == static_cast<std::size_t>(kModelTextureSide) * kModelTextureSide * 4);
+    require(t.rgba &&
+            t.rgba->size() == static_cast<std::size_t>(kModelTextureSide) * kModelTextureSide * 4);
   for (const auto& t : m.mesh.texcoords)
     require(t.layer == -1.0f ||
             (t.layer >= 0.0f && t.layer < static_cast<float>(m.textures.size()) &&

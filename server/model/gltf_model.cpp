@@ -179,8 +179,7 @@ ModelTexture to_layer(const encode::BgrxPixels& p) {
     return t;
   }();
   constexpr int n = kModelTextureSide;
-  ModelTexture out;
-  out.rgba.resize(static_cast<std::size_t>(n) * n * 4);
+  std::vector<std::uint8_t> rgba(static_cast<std::size_t>(n) * n * 4);
   for (int y = 0; y < n; ++y) {
     const int sy0 = y * p.height / n, sy1 = std::max(sy0 + 1, (y + 1) * p.height / n);
     for (int x = 0; x < n; ++x) {
@@ -196,12 +195,12 @@ ModelTexture to_layer(const encode::BgrxPixels& p) {
         }
       }
       const float k = 1.0f / static_cast<float>((sy1 - sy0) * (sx1 - sx0));
-      std::uint8_t* o = &out.rgba[(static_cast<std::size_t>(y) * n + x) * 4];
+      std::uint8_t* o = &rgba[(static_cast<std::size_t>(y) * n + x) * 4];
       for (int c = 0; c < 3; ++c) o[c] = linear_to_srgb(sum[c] * k);
       o[3] = static_cast<std::uint8_t>(std::lround(alpha * k));
     }
   }
-  return out;
+  return {std::make_shared<const std::vector<std::uint8_t>>(std::move(rgba))};
 }
 
 // --- from tinygltf's model to ours ------------------------------------------------------------

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -79,10 +80,11 @@ inline WindshieldOutline outline_of(const sim::GlassConfig& g) {
 }
 
 // A model's base-colour textures, each resampled to one layer of kModelTextureSide squared: RGBA,
-// 8 bits, sRGB-encoded, rows from the image's top (glTF's uv (0, 0)).
+// 8 bits, sRGB-encoded, rows from the image's top (glTF's uv (0, 0)). Shared by a model's copies
+// (a session's bonnet is its body's, marked for its glass: model::bonnet_for).
 inline constexpr int kModelTextureSide = 512;
 struct ModelTexture {
-  std::vector<std::uint8_t> rgba;  // kModelTextureSide^2 * 4
+  std::shared_ptr<const std::vector<std::uint8_t>> rgba;  // kModelTextureSide^2 * 4
 };
 
 struct VehicleModel {

@@ -77,7 +77,7 @@ ModelMesh::ModelMesh(const model::VehicleModel& m)
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   for (GLsizei l = 0; l < layers; ++l)
     glTextureSubImage3D(id, 0, 0, 0, l, side, side, 1, GL_RGBA, GL_UNSIGNED_BYTE,
-                        m.textures[static_cast<std::size_t>(l)].rgba.data());
+                        m.textures[static_cast<std::size_t>(l)].rgba->data());
   glGenerateTextureMipmap(id);
   glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
   glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);

@@ -321,15 +321,14 @@ TEST_F(VehicleClassesTest, AModelsTextureShows) {
   const sim::TrafficVehicle v = in_lane(s, sim::VehicleClass::kTruck, 5, 25.0, true);  // white
   auto textured = std::make_shared<model::VehicleModel>(model::default_vehicle(v.vehicle_class));
   constexpr int n = model::kModelTextureSide;
-  model::ModelTexture layer;
-  layer.rgba.resize(static_cast<std::size_t>(n) * n * 4);
+  std::vector<std::uint8_t> layer(static_cast<std::size_t>(n) * n * 4);
   for (int y = 0; y < n; ++y) {
     for (int x = 0; x < n; ++x) {
-      std::uint8_t* t = &layer.rgba[(static_cast<std::size_t>(y) * n + x) * 4];
+      std::uint8_t* t = &layer[(static_cast<std::size_t>(y) * n + x) * 4];
       t[0] = x < n / 2 ? 255 : 0, t[1] = 0, t[2] = x < n / 2 ? 0 : 255, t[3] = 255;
     }
   }
-  textured->textures = {layer};
+  textured->textures = {{std::make_shared<const std::vector<std::uint8_t>>(std::move(layer))}};
   for (const render::MeshVertex& vertex : textured->mesh.vertices)
     textured->mesh.texcoords.push_back({{vertex.position.y < 0.0f ? 0.25f : 0.75f, 0.5f}, 0.0f});
   const auto count = [&](bool texture) {

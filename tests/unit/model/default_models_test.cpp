@@ -96,3 +96,24 @@ INSTANTIATE_TEST_SUITE_P(DefaultModelsTest, BonnetTest, ::testing::Values(0, 1, 
 
 }  // namespace
 }  // namespace downpour::model
+
+namespace downpour::model {
+namespace {
+
+// A session's bonnet is a copy of its body marked for its glass: the body's texture layers (1 MB
+// each, up to 16) are shared with it, not copied.
+TEST(BonnetForTest, TheBonnetSharesItsBodysTextures) {
+  auto body = std::make_shared<VehicleModel>(default_vehicle(sim::VehicleClass::kCar));
+  body->textures = {{std::make_shared<const std::vector<std::uint8_t>>(
+      static_cast<std::size_t>(kModelTextureSide) * kModelTextureSide * 4, 200)}};
+  sim::GlassConfig raked;
+  raked.rake_deg += 5.0;
+  const sim::ModelPtr bonnet = bonnet_for(body, raked, sim::EgoGeometry{}.eye_m);
+  ASSERT_TRUE(bonnet);
+  ASSERT_EQ(bonnet->textures.size(), 1u);
+  EXPECT_EQ(bonnet->textures[0].rgba.get(), body->textures[0].rgba.get());
+  EXPECT_NE(bonnet->bonnet_index_count, 0u);
+}
+
+}  // namespace
+}  // namespace downpour::model

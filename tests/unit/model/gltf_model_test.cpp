@@ -148,7 +148,7 @@ TEST(GltfModelTest, ABaseColourTextureIsReadIntoALayer) {
   ASSERT_EQ(m.mesh.texcoords.size(), m.mesh.vertices.size());
   constexpr int n = kModelTextureSide;
   auto texel = [&](int x, int y) {
-    const std::uint8_t* t = &m.textures[0].rgba[(static_cast<std::size_t>(y) * n + x) * 4];
+    const std::uint8_t* t = &(*m.textures[0].rgba)[(static_cast<std::size_t>(y) * n + x) * 4];
     return std::array<int, 4>{t[0], t[1], t[2], t[3]};
   };
   EXPECT_EQ(texel(n / 4, n / 2), (std::array<int, 4>{255, 0, 0, 255}));
