@@ -5,7 +5,6 @@
 
 #include <glm/geometric.hpp>
 #include <glm/matrix.hpp>
-#include <glm/trigonometric.hpp>
 
 #include "server/render/cpu/shader_interface.hpp"
 #include "server/sim/pose.hpp"

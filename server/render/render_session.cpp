@@ -63,8 +63,7 @@ GLuint RenderSession::Impl::upload_road_water(
     road_dry_shown = false;
   }
   if (valid ? road_shown == image : road_dry_shown) return road_water[road_current].id();
-  // Into the texture the last frames' draws did not read: llvmpipe would otherwise finish the
-  // frame's passes so far before the upload (measured: the road pass's call took 2.2 ms more).
+  // Into the texture the last frames' draws did not read (kUploadCopies).
   road_current = (road_current + 1) % road_water.size();
   const GLuint id = road_water[road_current].id();
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);

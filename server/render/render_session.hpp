@@ -27,9 +27,9 @@ struct RenderSession::Impl {
   std::shared_ptr<const sim::GlassWaterSurface> surface_shown;
   // The world outside the glass, shared by the session's views (made on first use).
   std::unique_ptr<EnvironmentProbe> environment;
-  // The road's water window on the GPU, in turn in three textures, and the image the current one
-  // shows (held, so that its address names it).
-  std::array<Texture, 3> road_water;
+  // The road's water window on the GPU, in textures used in turn (kUploadCopies), and the image
+  // the current one shows (held, so that its address names it).
+  std::array<Texture, kUploadCopies> road_water;
   std::size_t road_current = 0;
   int road_cells = 0, road_rings = 0;
   std::shared_ptr<const sim::RoadWaterImage> road_shown;

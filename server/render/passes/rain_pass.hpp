@@ -84,17 +84,16 @@ class RainPass final : public Pass {
   const std::vector<std::uint8_t>& cabin_tiles_for(const FrameContext& frame, int width,
                                                    int height);
   std::vector<CabinTiles> cabin_tiles_;
-  // What a layer size needs: the layer, and a few textures and run buffers used in turn, so that
-  // an upload never waits for the GPU to finish drawing with the one before. Kept per size for
+  // What a layer size needs: the layer, and textures and run buffers used in turn
+  // (kUploadCopies, gl_objects.hpp). Kept per size for
   // the latest few sizes (kSizesKept), so that sessions whose views differ in size, rendered in
   // turn, re-create nothing; each layer has a helper thread of its own.
-  static constexpr int kTextures = 3;
   static constexpr std::size_t kSizesKept = 4;
   struct Sized {
     int width = 0, height = 0;
     RainLayer layer;
-    Texture colour[kTextures];
-    Buffer runs_buffer[kTextures];  // the runs of tiles to draw, uv over the view (rain.vert)
+    Texture colour[kUploadCopies];
+    Buffer runs_buffer[kUploadCopies];  // the runs of tiles to draw, uv over the view (rain.vert)
     int next = 0;
   };
   Sized& sized(int width, int height);
