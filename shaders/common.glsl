@@ -115,6 +115,20 @@ float fresnel_water(float cos_theta) {
   return 0.5 * a * a * (1.0 + b * b);
 }
 
+// What a glossy surface on the road (a car's paint, its windows) sees along dir: the sky above the
+// horizon; below it the road, a few metres off: its asphalt in the sun's and the sky's light
+// (darker wet), and over it the sky the road mirrors (Fresnel's term for rough asphalt dry, for
+// water as it wets), which at the horizon is the sky itself. Not the bright haze of distant ground
+// that sky_gradient gives there: a car's lower panels, and its rear seen in the road's mirror from
+// below, show the road in their sheen.
+vec3 surroundings(vec3 dir) {
+  vec3 sky = sky_gradient(vec3(dir.xy, abs(dir.z)));
+  float down = max(-dir.z, 0.0);
+  float f = mix(schlick(down, 0.02), fresnel_water(down), frame.wetness);
+  vec3 ground = vec3(mix(0.1, 0.05, frame.wetness)) * diffuse_light(vec3(0.0, 0.0, 1.0));
+  return mix(sky, mix(ground, sky, f), step(0.0, -dir.z));
+}
+
 // The light a cloud of droplets (the spray's haze) sends towards the eye where the screen's uv sees
 // it at distance z along the view's axis: the droplets' light from the sky and the scene (`light`,
 // linear) and the lamps' where their beams pass through the cloud's point. The frame's camera: the

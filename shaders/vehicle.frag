@@ -72,6 +72,6 @@ void main() {
                ego_headlights(v_world, outward);
   vec3 colour = albedo * light + emit;
   float f = schlick(dot(n, view), r0);
-  colour += sky_gradient(reflect(-view, n)) * f * gloss;
+  colour += surroundings(reflect(-view, n)) * f * gloss;
   out_colour = vec4(to_display(apply_fog(colour, v_fog)), 1.0);
 }

@@ -139,7 +139,8 @@ VehicleModel car(Detail detail) {
     return deck - rounding(front - x, 0.08f) - rounding(x - rear, 0.10f);
   };
   auto bottom = [&](float x) {
-    float z = 0.30f + rounding(front - x, 0.16f) + rounding(x - rear, 0.05f);
+    float z = static_cast<float>(body::kHullBottomZ) + rounding(front - x, 0.16f) +
+              rounding(x - rear, 0.05f);
     for (float axle : {0.0f, static_cast<float>(body::kWheelbase)}) {
       const float d = std::abs(x - axle), r = 0.42f;
       if (d < r) z = std::max(z, 0.33f + std::sqrt(r * r - d * d));

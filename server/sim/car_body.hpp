@@ -11,6 +11,7 @@ inline constexpr double kHullRearX = -0.9;
 inline constexpr double kHullFrontX = 3.6;
 inline constexpr double kHullHalfWidth = 0.88;
 inline constexpr double kHullTopZ = 0.92;
+inline constexpr double kHullBottomZ = 0.3;  // its underside, before it rises at the ends
 // The cabin on it, from the rear window's foot to the windshield's; the roof over part of it.
 inline constexpr double kCabinRearX = -0.55;
 inline constexpr double kCabinFrontX = 2.06;
