@@ -14,7 +14,8 @@
 //   metaballs instead of the simulation's, with the wiper blades at A and B degrees from +u
 //   (--blades; default 40 36); N = 0: the render tests' golden windshield. --dash: also the COCKPIT
 //   view from the forward (dash) camera.
-// --measure FRAMES: median costs over FRAMES frames of each COCKPIT and WINDSHIELD view: whole
+// --measure FRAMES: median costs over FRAMES frames of each COCKPIT, ROAD and WINDSHIELD view:
+// whole
 //   frames with profiling off, wall and CPU time of all threads (and the same frame with a dry
 //   windshield, no blades), then each
 //   pass with profiling on, in a renderer of its own (a glFinish mid-frame slows llvmpipe).
@@ -299,8 +300,7 @@ int main(int argc, char** argv) {
   if (measure_frames > 0) {
     std::vector<NamedView> measured;
     for (const NamedView& v : views) {
-      if (v.spec.view == sim::View::kCockpit || v.spec.view == sim::View::kWindshield)
-        measured.push_back(v);
+      if (v.spec.view != sim::View::kRain) measured.push_back(v);
     }
     measure(measured, scene, measure_frames);
     return 0;

@@ -59,7 +59,11 @@ vec3 lamp_lux(int i, vec3 p, vec3 n) {
 // The lamps' light on an upward surface at p, as radiance per unit albedo: the lamp map's fine
 // ring where it holds p (fading over its last 4 cells), else its coarse one (lamp_map.hpp).
 vec3 lamp_ground(vec3 p) {
-  // Without a lamp map (by day) the same for every pixel: no fetches.
+#ifdef NO_LAMPS
+  return vec3(0.0);
+#else
+  // Without a lamp map (by day) the same for every pixel. (llvmpipe still fetches: a program
+  // compiled with NO_LAMPS, where a frame has no lamps, does not.)
   if (frame.lamp_map.x < 0.5) return vec3(0.0);
   vec4 r0 = frame.lamp_rings[0], r1 = frame.lamp_rings[1];
   vec2 uv0 = (p.xy - r0.xy) * r0.z, uv1 = (p.xy - r1.xy) * r1.z;
@@ -69,6 +73,7 @@ vec3 lamp_ground(vec3 p) {
   vec3 fine = texture(lamp_map_tex, vec3(uv0, 0.0)).rgb;
   vec3 coarse = texture(lamp_map_tex, vec3(uv1, 1.0)).rgb;
   return mix(coarse * in1, fine, in0);
+#endif
 }
 
 // The lamps' light that water in the air at p scatters towards the eye (to_eye: unit, from p):
@@ -77,6 +82,9 @@ vec3 lamp_ground(vec3 p) {
 // as radiance.
 vec3 lamps_scattered(vec3 p, vec3 to_eye) {
   vec3 e = vec3(0.0);
+#ifdef NO_LAMPS
+  return e;
+#endif
   int n = min(int(lamps.count.y), int(lamps.count.x) + 2);
   for (int i = 0; i < n; ++i) {
     vec3 from_lamp = normalize(p - lamps.lamp[4 * i].xyz);
@@ -92,6 +100,9 @@ vec3 lamps_scattered(vec3 p, vec3 to_eye) {
 // block), as radiance per unit albedo.
 vec3 ego_headlights(vec3 p, vec3 n) {
   vec3 e = vec3(0.0);
+#ifdef NO_LAMPS
+  return e;
+#endif
   int ego = int(lamps.count.x);
   for (int i = 0; i < ego; ++i) e += lamp_lux(i, p, n);
   return e * frame.lamp_map.y;

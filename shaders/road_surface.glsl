@@ -310,11 +310,15 @@ void main() {
   // At night, the ego car's beams: the relief's shadows seen from between its two headlamps (the
   // first two of the lamp block), taken from their light here per pixel, which the lamp map holds
   // unshadowed. (Further off, where the shadows are not resolved, the beams' light stays whole.)
+#ifdef NO_LAMPS
+  vec3 beams_shadowed = vec3(0.0);
+#else
   vec3 beams = ego_headlights(v_world, n);
   vec3 to_beams = normalize(0.5 * (lamps.lamp[0].xyz + lamps.lamp[4].xyz) - v_world);
   vec3 lb = vec3(dot(to_beams, t_lat), dot(to_beams, t_along), dot(to_beams, n_geo));
   float beams_lit = relief_lit(lb, relief_tex, on_setts * float(u_horizon_directions), relief_h);
   vec3 beams_shadowed = beams * ((1.0 - beams_lit) * resolved * shadow_shows);
+#endif
 #else
   vec3 beams_shadowed = vec3(0.0);
 #endif
@@ -339,7 +343,9 @@ void main() {
 #ifdef ROAD_MIRROR
   float streak = 1.0 - smoothstep(0.3, 1.2, water.y);
   refl = mix(refl, mirrored(v_world, r, refl, streak), step(1e-3, smooth_water));
+#ifndef NO_LAMPS
   refl += lamp_glints(v_world, n_refl, view) * max(smooth_water, pool);
+#endif
 #endif
   // A sheen of the sun on the film, broader than the sun in the mirror.
   float sun = max(dot(r, frame.sun_dir.xyz), 0.0);

@@ -5,6 +5,7 @@
 #include <array>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <glm/mat3x3.hpp>
@@ -44,6 +45,8 @@ struct FrameContext {
   // The frame's lamps (light_set.hpp), once the renderer has made them: for the passes that light
   // what the lamp map does not hold (the rain's drops).
   const std::vector<Light>* lights = nullptr;
+  // Whether any lamp lights the frame (by day none is made: frame_lamps.cpp).
+  bool has_lamps() const { return lights && !lights->empty(); }
   // What is drawn of the session's roads (world.hpp).
   const World* world = nullptr;
   // Where a face of the environment is drawn from a client's picture: the camera the picture was
@@ -55,6 +58,15 @@ struct FrameContext {
   const sim::WindshieldState& water() const { return stepped().windshield; }
   const sim::RainState& rain() const { return stepped().rain; }
 };
+
+// A program that lights with the lamps (common.glsl's lamp_ground, ego_headlights,
+// lamps_scattered) is built twice: as is, and with NO_LAMPS, which compiles the lamps out for the
+// frames that have none. Their code returns nothing without lamps, yet llvmpipe runs both sides
+// of a branch, even one that every pixel takes alike: by day the lamp map's fetches cost the
+// road, the terrain and the vehicles a tenth of their time. The builds' defines, by
+// lamps_build().
+inline const std::vector<std::string> kLampBuilds[2] = {{}, {"NO_LAMPS"}};
+inline int lamps_build(const FrameContext& f) { return f.has_lamps() ? 0 : 1; }
 
 // A texture the passes draw into or read, with its size.
 struct TargetTexture {

@@ -10,8 +10,15 @@ namespace downpour::render {
 
 namespace {
 
-GLuint compile(GLenum stage, const std::string& file) {
-  const ShaderSource source = resolve_shader(file);
+GLuint compile(GLenum stage, const std::string& file, const std::vector<std::string>& defines) {
+  ShaderSource source = resolve_shader(file);
+  if (!defines.empty()) {
+    // After the #version line, which must come first; then the file's own numbering again.
+    const std::size_t after_version = source.text.find('\n') + 1;
+    std::string lines;
+    for (const std::string& d : defines) lines += "#define " + d + "\n";
+    source.text.insert(after_version, lines + "#line 2 0\n");
+  }
   const GLuint shader = glCreateShader(stage);
   const char* text = source.text.c_str();
   glShaderSource(shader, 1, &text, nullptr);
@@ -59,12 +66,14 @@ Texture make_texture_2d_array(GLenum internal_format, int width, int height, int
   return Texture(id);
 }
 
-ShaderProgram::ShaderProgram(const std::string& vertex_file, const std::string& fragment_file)
+ShaderProgram::ShaderProgram(const std::string& vertex_file, const std::string& fragment_file,
+                             const std::vector<std::string>& defines)
     : files_(vertex_file + " + " + fragment_file) {
-  const GLuint vs = compile(GL_VERTEX_SHADER, vertex_file);
+  for (const std::string& d : defines) files_ += " (" + d + ")";
+  const GLuint vs = compile(GL_VERTEX_SHADER, vertex_file, defines);
   GLuint fs = 0;
   try {
-    fs = compile(GL_FRAGMENT_SHADER, fragment_file);
+    fs = compile(GL_FRAGMENT_SHADER, fragment_file, defines);
   } catch (...) {
     glDeleteShader(vs);
     throw;

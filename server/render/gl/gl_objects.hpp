@@ -93,11 +93,12 @@ class Uniform {
 };
 
 // A linked program from embedded shader files (by file name, e.g. "sky.frag"), their
-// `#include "x.glsl"` lines resolved (shader_source.hpp). Throws with the driver's log, its
-// locations named by file.
+// `#include "x.glsl"` lines resolved (shader_source.hpp), with `defines` (macro names, e.g.
+// kNoLamps) defined in both stages. Throws with the driver's log, its locations named by file.
 class ShaderProgram {
  public:
-  ShaderProgram(const std::string& vertex_file, const std::string& fragment_file);
+  ShaderProgram(const std::string& vertex_file, const std::string& fragment_file,
+                const std::vector<std::string>& defines = {});
   void use() const { glUseProgram(program_.id()); }
   // Throws std::logic_error if the program has no such active uniform: a misspelt name fails at
   // start-up, not silently.

@@ -27,20 +27,19 @@ constexpr float kBeamsReachRoadM = 4.0f;
 
 }  // namespace
 
-RoadPass::RoadPass(SharedResources& shared)
-    : programs_{ShaderProgram("road.vert", "road.frag"),
-                ShaderProgram("road.vert", "road_mirror.frag"),
-                ShaderProgram("road.vert", "road_ripples.frag"),
-                ShaderProgram("road.vert", "road_relief.frag"),
-                ShaderProgram("road.vert", "road_mirror_relief.frag"),
-                ShaderProgram("road.vert", "road_ripples_relief.frag")},
-      reliefs_(shared.reliefs) {
-  for (const ShaderProgram& program : programs_) program.uniform("u_model").set(glm::mat4(1.0f));
+RoadPass::RoadPass(SharedResources& shared) : reliefs_(shared.reliefs) {
+  const char* const files[kVariants] = {
+      "road.frag",        "road_mirror.frag",        "road_ripples.frag",
+      "road_relief.frag", "road_mirror_relief.frag", "road_ripples_relief.frag"};
+  programs_.reserve(2 * kVariants);
+  for (const std::vector<std::string>& build : kLampBuilds) {
+    for (const char* file : files) programs_.emplace_back("road.vert", file, build);
+  }
   for (std::size_t p = 0; p < programs_.size(); ++p) {
+    programs_[p].uniform("u_model").set(glm::mat4(1.0f));
     mean_lit_[p] = programs_[p].uniform("u_relief_mean_lit");
     near_split_[p] = programs_[p].uniform("u_near_split");
-  }
-  for (std::size_t p = 3; p < programs_.size(); ++p) {
+    if (p % kVariants < 3) continue;  // (the relief's)
     programs_[p].uniform("u_horizon_directions").set(shared.horizon_directions);
     programs_[p]
         .uniform("u_relief_depth_m")
@@ -82,7 +81,10 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
         return glm::length(lit - glm::vec2(frame.camera.position)) < reach;
       });
   drew_relief_ = relief_ && (std::max({sun.r, sun.g, sun.b}) > kReliefSunFrom || beams);
-  const std::size_t plain = ripples ? 2 : mirror ? 1 : 0;
+  const std::size_t plain =
+      static_cast<std::size_t>(lamps_build(frame)) * kVariants + (ripples  ? 2
+                                                                  : mirror ? 1
+                                                                           : 0);
   const glm::mat4 view_proj = frame.camera.projection * frame.camera.view;
   // Relief shadows: the near road with them, the rest without (llvmpipe would fetch the horizon
   // maps on every pixel of one draw, even where a branch skips them). Where a pixel covers many

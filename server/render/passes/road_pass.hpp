@@ -2,6 +2,7 @@
 
 #include <array>
 #include <memory>
+#include <vector>
 
 #include "server/render/chunked_mesh.hpp"
 #include "server/render/pass.hpp"
@@ -35,11 +36,13 @@ class RoadPass final : public Pass {
                        {DepthTest::kNearer, true, Blend::kOff, true, false, 0b10}};
   // road.frag, road_mirror.frag, road_ripples.frag, then the same with relief shadows
   // (road_surface.glsl): llvmpipe pays for both sides of a branch on every pixel, so the mirror,
-  // the ripples and the shadows are programs of their own.
-  std::array<ShaderProgram, 6> programs_;
+  // the ripples and the shadows are programs of their own. Each in both lamps_build()s: the
+  // variants with lamps, then those without.
+  static constexpr std::size_t kVariants = 6;
+  std::vector<ShaderProgram> programs_;
   // Each program's per-frame uniforms, looked up once.
-  std::array<Uniform, 6> mean_lit_;
-  std::array<Uniform, 6> near_split_;
+  std::array<Uniform, 2 * kVariants> mean_lit_;
+  std::array<Uniform, 2 * kVariants> near_split_;
   std::shared_ptr<const relief::RoadReliefs> reliefs_;
   bool relief_ = true;
   bool drew_relief_ = false;

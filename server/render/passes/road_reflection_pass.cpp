@@ -26,6 +26,7 @@ void RoadReflectionPass::execute(const FrameContext& f, const FrameResources& r)
   // At a quarter of the view's size it needs a quarter of the detail.
   mf.detail_distance_scale = f.detail_distance_scale * static_cast<float>(kRoadReflectionScale);
   mf.world = f.world;
+  mf.lights = f.lights;  // (the lamp block holds them: the mirror's passes light with them too)
   block_.upload(mf, WaterBlock{});
   for (const Reflected& pass : reflected_) {
     glm::vec4 plane = mirror.plane;

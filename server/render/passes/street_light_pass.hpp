@@ -1,5 +1,7 @@
 #pragma once
 
+#include <array>
+
 #include "server/render/chunked_mesh.hpp"
 #include "server/render/pass.hpp"
 
@@ -22,8 +24,8 @@ class StreetLightPass final : public Pass {
                        {},
                        {Resource::kViewColour, Resource::kViewDepth},
                        {DepthTest::kNearer, true, Blend::kOff}};
-  ShaderProgram program_;
-  Uniform u_head_;
+  std::array<ShaderProgram, 2> programs_;  // by lamps_build()
+  std::array<Uniform, 2> u_head_;
 };
 
 }  // namespace downpour::render

@@ -4,12 +4,14 @@
 
 namespace downpour::render {
 
-TerrainPass::TerrainPass(SharedResources&) : program_("mesh.vert", "terrain.frag") {
-  program_.uniform("u_model").set(glm::mat4(1.0f));
+TerrainPass::TerrainPass(SharedResources&)
+    : programs_{ShaderProgram("mesh.vert", "terrain.frag", kLampBuilds[0]),
+                ShaderProgram("mesh.vert", "terrain.frag", kLampBuilds[1])} {
+  for (const ShaderProgram& program : programs_) program.uniform("u_model").set(glm::mat4(1.0f));
 }
 
 void TerrainPass::execute(const FrameContext& frame, const FrameResources&) {
-  program_.use();
+  programs_[lamps_build(frame)].use();
   frame.world->terrain.draw_visible(frame.camera.projection * frame.camera.view,
                                     frame.camera.position, frame.detail_distance_scale);
 }

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <array>
+
 #include "server/render/pass.hpp"
 
 namespace downpour::render {
@@ -17,7 +19,7 @@ class TerrainPass final : public Pass {
                        {Resource::kLampMap},
                        {Resource::kViewColour, Resource::kViewDepth},
                        {DepthTest::kNearer, true, Blend::kOff}};
-  ShaderProgram program_;
+  std::array<ShaderProgram, 2> programs_;  // by lamps_build()
 };
 
 }  // namespace downpour::render

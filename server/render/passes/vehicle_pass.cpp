@@ -11,13 +11,15 @@
 
 namespace downpour::render {
 
-VehiclePass::VehiclePass(SharedResources&)
-    : program_("model.vert", "vehicle.frag"),
-      uniforms_(program_),
-      u_body_colour_(program_.uniform("u_body_colour")),
-      u_lamps_(program_.uniform("u_lamps")),
-      u_head_(program_.uniform("u_head")),
-      u_wet_(program_.uniform("u_wet")) {
+VehiclePass::Build::Build(const std::vector<std::string>& defines)
+    : program("model.vert", "vehicle.frag", defines),
+      uniforms(program),
+      u_body_colour(program.uniform("u_body_colour")),
+      u_lamps(program.uniform("u_lamps")),
+      u_head(program.uniform("u_head")),
+      u_wet(program.uniform("u_wet")) {}
+
+VehiclePass::VehiclePass(SharedResources&) : builds_{Build(kLampBuilds[0]), Build(kLampBuilds[1])} {
   for (const sim::VehicleClass c : {sim::VehicleClass::kCar, sim::VehicleClass::kTruck,
                                     sim::VehicleClass::kBus, sim::VehicleClass::kMotorbike}) {
     near_.emplace_back(model::default_vehicle(c, model::Detail::kFull));
@@ -27,19 +29,20 @@ VehiclePass::VehiclePass(SharedResources&)
 
 void VehiclePass::prepare(const glm::vec3& colour, const sim::VehicleLights& lights, bool flash_on,
                           float body_wet) {
-  u_body_colour_.set(colour);
-  u_wet_.set(body_wet);
+  build_->u_body_colour.set(colour);
+  build_->u_wet.set(body_wet);
   const bool heads =
       lights.headlights == sim::Headlights::kLow || lights.headlights == sim::Headlights::kHigh;
   const float flash = flash_on ? 1.0f : 0.0f;
-  u_lamps_.set(glm::vec4(heads ? 1.0f : 0.0f, lights.brake ? 1.0f : 0.0f,
-                         lights.left_indicator ? flash : 0.0f,
-                         lights.right_indicator ? flash : 0.0f));
-  u_head_.set(lights.headlights == sim::Headlights::kHigh ? 2.0f : heads ? 1.0f : 0.0f);
+  build_->u_lamps.set(glm::vec4(heads ? 1.0f : 0.0f, lights.brake ? 1.0f : 0.0f,
+                                lights.left_indicator ? flash : 0.0f,
+                                lights.right_indicator ? flash : 0.0f));
+  build_->u_head.set(lights.headlights == sim::Headlights::kHigh ? 2.0f : heads ? 1.0f : 0.0f);
 }
 
 void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
-  program_.use();
+  build_ = &builds_[lamps_build(frame)];
+  build_->program.use();
   // From the driver's eye (COCKPIT, and RAIN, which sees from it) only the hood shows.
   const bool cockpit =
       frame.spec.view == sim::View::kCockpit || frame.spec.view == sim::View::kRain;
@@ -56,8 +59,8 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
   const ModelMesh* ego = ego_model ? &named_.get(ego_model) : &near_[car];
   // From the seat, the body as marked for the session's glass and eye (where they differ).
   if (cockpit && frame.scene.ego.bonnet_model) ego = &named_.get(frame.scene.ego.bonnet_model);
-  ego->draw(uniforms_, glm::scale(frame.vehicle_to_world, ego_scale), frame.scene.ego_rolled_m,
-            cockpit);
+  ego->draw(build_->uniforms, glm::scale(frame.vehicle_to_world, ego_scale),
+            frame.scene.ego_rolled_m, cockpit);
   // A vehicle under 40 pixels tall is drawn from its model for the distance.
   const float pixels_per_radian = 0.5f * static_cast<float>(frame.spec.height) /
                                   static_cast<float>(frame.camera.tan_half_fov_y);
@@ -91,7 +94,7 @@ void VehiclePass::execute(const FrameContext& frame, const FrameResources&) {
         static_cast<float>(other.size_m.z) * pixels_per_radian < 40.0f * std::max(distance, 0.1f);
     const auto c = static_cast<std::size_t>(other.vehicle_class);
     const ModelMesh& shape = other.model ? named_.get(other.model) : small ? far_[c] : near_[c];
-    shape.draw(uniforms_, model, rolled, false);
+    shape.draw(build_->uniforms, model, rolled, false);
   }
 }
 

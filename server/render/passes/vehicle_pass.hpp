@@ -1,6 +1,8 @@
 #pragma once
 
+#include <array>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "server/render/model_meshes.hpp"
@@ -27,9 +29,15 @@ class VehiclePass final : public Pass {
                        {Resource::kLampMap},
                        {Resource::kViewColour, Resource::kViewDepth},
                        {DepthTest::kNearer, true, Blend::kOff}};
-  ShaderProgram program_;
-  ModelUniforms uniforms_;
-  Uniform u_body_colour_, u_lamps_, u_head_, u_wet_;
+  // The program in one of its lamps_build()s, and its uniforms.
+  struct Build {
+    explicit Build(const std::vector<std::string>& defines);
+    ShaderProgram program;
+    ModelUniforms uniforms;
+    Uniform u_body_colour, u_lamps, u_head, u_wet;
+  };
+  std::array<Build, 2> builds_;
+  const Build* build_ = &builds_[0];  // this frame's
   // Each class's built-in model in full and for the distance (default_models.hpp's Detail): by
   // class. The models sessions name, as their scenes hold them.
   std::vector<ModelMesh> near_, far_;
