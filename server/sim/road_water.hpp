@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <span>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -220,7 +221,7 @@ class RoadWater {
   double old_volume(int level, glm::ivec2 cell) const;
   // Shares volume_m3 out to cells of the new windows: the texture first, evenly, then a film of up
   // to film_m evenly, then the hollows, deepest first, then the rest evenly.
-  void share_out(const std::vector<std::size_t>& cells, double volume_m3, double film_m);
+  void share_out(std::span<const std::size_t> cells, double volume_m3, double film_m);
   // Of a cell's standing water, what stays where it is (m): in a coarse cell what its hollows
   // hold, in a finest cell all of a puddle's (the rest is film, which runs).
   double held_m(double water, double hollow, bool coarse) const {
@@ -267,7 +268,11 @@ class RoadWater {
   std::vector<RoadPlace> old_places_;
   std::vector<std::uint8_t> old_paved_, old_owned_;
   std::array<glm::ivec2, kRoadWaterMaxLevels> old_origins_{};
-  std::map<Source, std::vector<std::size_t>> shares_;
+  // The new cells by the source of their water (sorted by source, then cell: each source's cells
+  // in the order they were found), and one source's cells: kept, so that a move allocates nothing
+  // once they have grown (a map of vectors made and freed its nodes on every move).
+  std::vector<std::pair<Source, std::size_t>> shares_;
+  std::vector<std::size_t> sharing_;
   std::map<Key, Record> records_;  // by coarsest cell
   Ledger ledger_;
 };

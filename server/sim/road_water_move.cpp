@@ -176,11 +176,19 @@ void RoadWater::hand_water_on(const std::array<bool, kRoadWaterMaxLevels>& moved
             break;
           }
         }
-        shares_[source].push_back(c);
+        shares_.emplace_back(source, c);
       }
     }
   }
-  for (auto& [source, cells] : shares_) {
+  std::sort(shares_.begin(), shares_.end(), [](const auto& a, const auto& b) {
+    return a.first < b.first || (!(b.first < a.first) && a.second < b.second);
+  });
+  for (std::size_t begin = 0; begin < shares_.size();) {
+    const Source source = shares_[begin].first;
+    sharing_.clear();
+    for (; begin < shares_.size() && !(source < shares_[begin].first); ++begin)
+      sharing_.push_back(shares_[begin].second);
+    const std::span<const std::size_t> cells(sharing_);
     const glm::ivec2 d =
         source.level >= 0 ? source.cell - old_origins_[source.level] : glm::ivec2(0);
     const bool from_cell = source.level >= 0 && old_paved_[flat(source.level, d.x, d.y)];
@@ -251,7 +259,7 @@ double RoadWater::old_volume(int level, glm::ivec2 cell) const {
   return sum;
 }
 
-void RoadWater::share_out(const std::vector<std::size_t>& cells, double volume_m3, double film_m) {
+void RoadWater::share_out(std::span<const std::size_t> cells, double volume_m3, double film_m) {
   auto level_of = [&](std::size_t c) { return static_cast<int>(c / layer()); };
   double paved_area = 0.0, hollows = 0.0, deepest = 0.0;
   for (const std::size_t c : cells) {
