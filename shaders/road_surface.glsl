@@ -15,8 +15,9 @@ out vec4 out_colour;
 // on its borders, packed. (Flat: one varying, where llvmpipe pays for every one on every pixel.)
 flat in vec4 v_strip;
 
-const float kReliefTile = 1.5;  // metres of road per repeat of the relief texture (relief.hpp)
+const float kReliefTile = 1.5;  // metres of road per repeat of the asphalt's relief (relief.hpp)
 const float kSettsTile = 1.0;   // the setts' (relief.hpp)
+const float kGroundTile = 3.0;  // of both in ground_relief_tex (relief.hpp's kGroundTileM)
 const float kSettsWidth = 1.0;  // the band of setts from the pavement's edge out
 
 // The sunlight the asphalt's and the setts' relief keep past their shadows, over many texels
@@ -241,13 +242,14 @@ void main() {
   // The pavement's asphalt, then a band of stone setts on the shoulder, then gravel and grass.
   float verge = smoothstep(0.0, 0.05, verge_d);
   float setts_band = verge * step(verge_d, kSettsWidth);
-  vec4 relief = texture(asphalt_tex, vec2(lat, s) / kReliefTile);
-  vec4 setts = texture(setts_tex, vec2(lat, s) / kSettsTile);
+  // One fetch, from the setts' layer or the asphalt's: it switches halfway through the 5 cm where
+  // the pavement's colour blends into the setts'.
+  vec4 relief = texture(ground_relief_tex, vec3(vec2(lat, s) / kGroundTile, step(0.5, setts_band)));
   // Fade the relief with distance, where its texels get smaller than a pixel (the setts', four
   // times the size, later).
   float px = length(fwidth(v_uv));
   float detail = clamp(1.5 - px * mix(6.0, 1.5, setts_band), 0.0, 1.0);
-  vec3 rn = mix(relief.rgb, setts.rgb, setts_band) * 2.0 - 1.0;
+  vec3 rn = relief.rgb * 2.0 - 1.0;
   vec3 n = normalize(mix(n_geo, normalize(t_lat * rn.x + t_along * rn.y + n_geo * rn.z), detail));
 
   // Asphalt: light aggregate in dark binder; worn, darker wheel paths; patches.
@@ -274,7 +276,7 @@ void main() {
   float course = floor(s / kSettsTile * 10.0);  // relief.hpp: 8 setts across a tile, 10 courses
   vec2 sett_id = vec2(floor(lat / kSettsTile * 8.0 + 0.5 * mod(course, 2.0)), course);
   float stone = fract(sin(dot(sett_id, vec2(12.9898, 78.233))) * 43758.5453);
-  vec3 sett = vec3(0.2, 0.19, 0.18) * (0.75 + 0.5 * stone) * mix(0.55, 1.0, smoothstep(0.2, 0.5, setts.a));
+  vec3 sett = vec3(0.2, 0.19, 0.18) * (0.75 + 0.5 * stone) * mix(0.55, 1.0, smoothstep(0.2, 0.5, relief.a));
   vec3 gravel = vec3(0.16, 0.15, 0.13) * (0.7 + 0.6 * h);
   vec3 grass = vec3(0.11, 0.16, 0.06) * (0.8 + 0.4 * patches);
   vec3 beyond = mix(gravel, grass, smoothstep(1.6, 2.8, verge_d));
@@ -299,7 +301,7 @@ void main() {
   vec3 l = vec3(dot(frame.sun_dir.xyz, t_lat), dot(frame.sun_dir.xyz, t_along),
                 dot(frame.sun_dir.xyz, n_geo));
   vec2 relief_tex = vec2(lat, s) / mix(kReliefTile, kSettsTile, on_setts);
-  float relief_h = mix(relief.a * u_relief_depth_m.x, setts.a * u_relief_depth_m.y, on_setts);
+  float relief_h = relief.a * mix(u_relief_depth_m.x, u_relief_depth_m.y, on_setts);
   // Shadows texel by texel where a pixel covers a few texels (the asphalt's up to 1-3 cm, the
   // setts' 1.5-4 cm: within some metres of the camera); further off, their mean, not a pixel's
   // pick of them. This program draws only the road near the camera (road_pass.cpp), since

@@ -102,10 +102,11 @@ struct FrameResources {
 
 // Resources made once and shared by the passes.
 struct SharedResources {
-  Texture noise;    // make_noise, repeat
-  Texture asphalt;  // make_asphalt_relief, repeat, mipmapped
+  Texture noise;  // make_noise, repeat
+  // The asphalt's relief and the setts', two layers over one tile (shared_resources.cpp), repeat,
+  // mipmapped.
+  Texture ground_relief;
   FullscreenTriangle fullscreen;
-  Texture setts;    // the shoulder's relief, repeat, mipmapped
   Texture horizon;  // relief::road_reliefs' horizon maps, RG16F, a layer per azimuth and relief
   int horizon_directions = 0;
   std::shared_ptr<const relief::RoadReliefs> reliefs;

@@ -111,6 +111,8 @@ struct RoadReliefs {
 };
 inline constexpr float kAsphaltTileM = 1.5f;
 inline constexpr float kSettsTileM = 1.0f;
+// The tile of both on the GPU (shared_resources.cpp: two asphalt tiles, three of the setts).
+inline constexpr float kGroundTileM = 3.0f;
 // The asphalt's stones: their tops 4 to 9 mm over the binder.
 inline constexpr float kAsphaltDepthM = 3.0f * kAsphaltTileM / 512.0f;
 // The setts: 2 cm from the joints' floor to a stone's crown.

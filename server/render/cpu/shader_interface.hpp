@@ -18,7 +18,9 @@ namespace downpour::render {
 // Texture units: X(C++ name, unit, GLSL sampler type, GLSL name, what it holds).
 #define DOWNPOUR_TEXTURE_UNITS(X)                                                                  \
   X(kNoise, 1, sampler2D, noise_tex, "value noise, 4 frequencies in rgba, repeating")              \
-  X(kAsphalt, 2, sampler2D, asphalt_tex, "asphalt relief: rgb normal, a height (seed 003, 3.1)")   \
+  X(kGroundRelief, 2, sampler2DArray, ground_relief_tex,                                           \
+    "the road's reliefs over a 3 m tile, rgb normal, a height: the asphalt (seed 003, 3.1), the "  \
+    "shoulder's setts")                                                                            \
   X(kSky, 3, sampler2D, sky_tex,                                                                   \
     "the clear sky by the sun's place, less the frame's gradient (sky_table.hpp): columns from "   \
     "the sun's azimuth round, rows sqrt(sin elevation)")                                           \
@@ -45,7 +47,6 @@ namespace downpour::render {
     "the spray over the scene, reduced size, premultiplied")                                       \
   X(kSprayHaze, 15, sampler2D, spray_haze_tex,                                                     \
     "the spray's haze, a quarter of the view: r optical depth, g that times distance (m)")         \
-  X(kSetts, 16, sampler2D, setts_tex, "the shoulder's stone setts: rgb normal, a height")          \
   X(kHorizon, 17, sampler2DArray, horizon_tex,                                                     \
     "the reliefs' horizon maps (seed 002), a layer per azimuth k, the asphalt's then the setts': " \
     "rg tan(beta) and distance at k, ba at k + 1, encoded (relief.hpp)")                           \

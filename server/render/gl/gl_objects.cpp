@@ -57,11 +57,12 @@ Texture make_texture_2d(GLenum internal_format, int width, int height, int level
   return Texture(id);
 }
 
-Texture make_texture_2d_array(GLenum internal_format, int width, int height, int layers) {
+Texture make_texture_2d_array(GLenum internal_format, int width, int height, int layers,
+                              int levels) {
   GLuint id = 0;
   glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
-  glTextureStorage3D(id, 1, internal_format, width, height, layers);
-  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureStorage3D(id, levels, internal_format, width, height, layers);
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, levels > 1 ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR);
   glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   return Texture(id);
 }

@@ -64,7 +64,8 @@ Buffer make_buffer();
 
 Texture make_texture_2d(GLenum internal_format, int width, int height, int levels = 1);
 // Layers of one size, filtered linearly within a layer.
-Texture make_texture_2d_array(GLenum internal_format, int width, int height, int layers);
+Texture make_texture_2d_array(GLenum internal_format, int width, int height, int layers,
+                              int levels = 1);
 
 // A uniform's location in a program, looked up once (when the pass is made) and set by handle.
 class Uniform {
