@@ -130,8 +130,8 @@ float fresnel_water(float cos_theta) {
 // horizon; below it the road, a few metres off: its asphalt in the sun's and the sky's light
 // (darker wet), and over it the sky the road mirrors (Fresnel's term for rough asphalt dry, for
 // water as it wets), which at the horizon is the sky itself. Not the bright haze of distant ground
-// that sky_gradient gives there: a car's lower panels, and its rear seen in the road's mirror from
-// below, show the road in their sheen.
+// that sky_gradient gives there: a car's lower panels, and its rear seen from a camera above it,
+// show the road in their sheen. (Seen from below, in the road's mirror, the rear shows the sky.)
 vec3 surroundings(vec3 dir) {
   vec3 sky = sky_gradient(vec3(dir.xy, abs(dir.z)));
   float down = max(-dir.z, 0.0);

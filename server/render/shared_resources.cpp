@@ -14,11 +14,15 @@ namespace downpour::render {
 
 namespace {
 
-Texture upload_repeating(const Image8& image, bool mipmaps) {
+// A full mip chain's levels for a square of this side.
+int mip_levels(int side) {
   int levels = 1;
-  if (mipmaps) {
-    for (int s = image.width; s > 1; s /= 2) ++levels;
-  }
+  for (int s = side; s > 1; s /= 2) ++levels;
+  return levels;
+}
+
+Texture upload_repeating(const Image8& image, bool mipmaps) {
+  const int levels = mipmaps ? mip_levels(image.width) : 1;
   Texture t = make_texture_2d(GL_RGBA8, image.width, image.height, levels);
   glTextureSubImage2D(t.id(), 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE,
                       image.rgba.data());
@@ -51,9 +55,7 @@ Texture ground_reliefs(const relief::RoadReliefs& r) {
   }
   const Image8 setts_image =
       relief_image(setts, kSize, relief::kSettsDepthM * kSize / relief::kGroundTileM);
-  int levels = 1;
-  for (int s = kSize; s > 1; s /= 2) ++levels;
-  Texture t = make_texture_2d_array(GL_RGBA8, kSize, kSize, 2, levels);
+  Texture t = make_texture_2d_array(GL_RGBA8, kSize, kSize, 2, mip_levels(kSize));
   for (int ty = 0; ty < 2; ++ty) {
     for (int tx = 0; tx < 2; ++tx) {
       glTextureSubImage3D(t.id(), 0, tx * asphalt.width, ty * asphalt.height, 0, asphalt.width,

@@ -95,7 +95,8 @@ class Uniform {
 
 // A linked program from embedded shader files (by file name, e.g. "sky.frag"), their
 // `#include "x.glsl"` lines resolved (shader_source.hpp), with `defines` (macro names, e.g.
-// kNoLamps) defined in both stages. Throws with the driver's log, its locations named by file.
+// kLampBuilds' NO_LAMPS) defined in both stages. Throws with the driver's log, its locations named
+// by file.
 class ShaderProgram {
  public:
   ShaderProgram(const std::string& vertex_file, const std::string& fragment_file,
