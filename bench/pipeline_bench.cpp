@@ -568,6 +568,8 @@ int main(int argc, char** argv) {
   app.add_flag("--client-background", client_background,
                "only COCKPIT over a client's pictures (a JPEG each step) at each size: lockstep "
                "steps a second and the decode's share");
+  bool demo_only = false;
+  app.add_flag("--demo-only", demo_only, "only the demo session (COCKPIT + ROAD, realtime)");
   bool outputs = false;
   app.add_flag("--outputs", outputs,
                "with --client-background: also with the clean frame and the water mask asked for");
@@ -610,7 +612,7 @@ int main(int argc, char** argv) {
     std::printf("%s\n", out.dump(2).c_str());
     return 0;
   }
-  if (rain_only || wet_road_only) sizes.clear();
+  if (rain_only || wet_road_only || demo_only) sizes.clear();
   for (const std::string& size : sizes) {
     int width = 0, height = 0;
     if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16) {
@@ -645,11 +647,11 @@ int main(int argc, char** argv) {
     out["results"].push_back(r);
     std::fprintf(stderr, "%s done\n", size.c_str());
   }
-  if (!wet_road_only)
+  if (!wet_road_only && !demo_only)
     out["rain"] = measure_rain(scenario, std::min(frames, 30), std::min(warm_s, 2.0));
-  if (!rain_only)
+  if (!rain_only && !demo_only)
     out["wet_road"] = measure_wet_road(scenario, std::min(frames, 30), std::min(warm_s, 2.0));
-  if (demo && !rain_only && !wet_road_only) {
+  if ((demo || demo_only) && !rain_only && !wet_road_only) {
     const std::vector<sim::ViewSpec> views = {sim::view_spec(sim::View::kCockpit, 640, 360),
                                               sim::view_spec(sim::View::kRoad, 640, 360)};
     out["demo"] = measure_realtime(scenario, views, realtime_s, warm_s);
