@@ -1,5 +1,7 @@
 #include "server/encode/encoder_pool.hpp"
 
+#include <pthread.h>
+
 #include <chrono>
 #include <exception>
 
@@ -12,7 +14,12 @@ constexpr std::size_t kMaxSpareBuffers = 16;
 }
 
 EncoderPool::EncoderPool(int threads, int max_queued) : max_queued_(max_queued) {
-  for (int i = 0; i < threads; ++i) workers_.emplace_back([this] { run(); });
+  for (int i = 0; i < threads; ++i) {
+    workers_.emplace_back([this] {
+      pthread_setname_np(pthread_self(), "dp-encode");  // (as top -H and perf show it)
+      run();
+    });
+  }
 }
 
 EncoderPool::~EncoderPool() {

@@ -92,7 +92,10 @@ FrameScheduler::~FrameScheduler() { stop(); }
 void FrameScheduler::start() {
   std::promise<void> started;
   auto ready = started.get_future();
-  thread_ = std::thread([this, &started] { run(&started); });
+  thread_ = std::thread([this, &started] {
+    sim::name_this_thread("dp-render");
+    run(&started);
+  });
   try {
     ready.get();
   } catch (...) {

@@ -121,7 +121,7 @@ class FrameScheduler {
   };
   std::optional<StepAhead> ahead_;
   Clock::time_point stats_published_;
-  sim::WorkerThread step_worker_;
+  sim::WorkerThread step_worker_{"dp-step"};
   std::thread thread_;
 
   std::mutex wake_mutex_;

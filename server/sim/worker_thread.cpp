@@ -1,11 +1,24 @@
 #include "server/sim/worker_thread.hpp"
 
+#include <pthread.h>
+
+#include <cstring>
 #include <stdexcept>
 #include <utility>
 
 namespace downpour::sim {
 
-WorkerThread::WorkerThread() : thread_([this] { run(); }) {}
+void name_this_thread(const char* name) {
+  char shortened[16] = {};
+  std::strncpy(shortened, name, sizeof shortened - 1);
+  pthread_setname_np(pthread_self(), shortened);
+}
+
+WorkerThread::WorkerThread(const char* name)
+    : thread_([this, name] {
+        name_this_thread(name);
+        run();
+      }) {}
 
 WorkerThread::~WorkerThread() {
   {

@@ -12,9 +12,13 @@
 
 namespace downpour::sim {
 
+// Names a thread as `top -H`, perf and gdb show it (at most 15 characters).
+void name_this_thread(const char* name);
+
 class WorkerThread {
  public:
-  WorkerThread();
+  // `name`: the thread's (name_this_thread).
+  explicit WorkerThread(const char* name);
   ~WorkerThread();
   WorkerThread(const WorkerThread&) = delete;
   WorkerThread& operator=(const WorkerThread&) = delete;

@@ -183,7 +183,7 @@ class RainLayer {
   std::vector<std::uint16_t> occluder_depth_;  // cm
   std::vector<glm::uvec3> hazed_;              // the resolve's colours by lamp light and distance
   Bounds occluded_;
-  sim::WorkerThread helper_;
+  sim::WorkerThread helper_{"dp-rain"};
   // Each thread's batch of drops being projected (rain_layer.cpp), made once.
   std::unique_ptr<Batch> batches_[2];  // draws half the drops, resolves half the rows
   std::vector<Texel> texels_;

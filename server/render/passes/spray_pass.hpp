@@ -109,7 +109,7 @@ class SprayPass final : public Pass {
   std::vector<glm::vec4> liquid_runs_, body_runs_, all_runs_;
   std::vector<std::uint8_t> liquid_tiles_, body_tiles_, all_tiles_;
   Drawn drawn_;
-  sim::WorkerThread helper_;  // draws the haze beside the liquid's maps (CPU)
+  sim::WorkerThread helper_{"dp-spray"};  // draws the haze beside the liquid's maps (CPU)
 };
 
 class SpraySmoothPass final : public Pass {
