@@ -1,0 +1,42 @@
+// The step's worker thread: its jobs run one at a time, and it carries the name it was given (what
+// `top -H` and perf show), cut to the 15 characters a thread name holds.
+#include "server/sim/worker_thread.hpp"
+
+#include <pthread.h>
+
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace downpour::sim {
+namespace {
+
+std::string name_on(WorkerThread& worker) {
+  std::string name;
+  worker.start([&name] {
+    char buffer[16] = {};
+    pthread_getname_np(pthread_self(), buffer, sizeof buffer);
+    name = buffer;
+  });
+  worker.wait();
+  return name;
+}
+
+TEST(WorkerThreadTest, RunsItsJobsUnderItsName) {
+  WorkerThread worker("dp-test");
+  EXPECT_EQ(name_on(worker), "dp-test");
+  int sum = 0;
+  for (int i = 1; i <= 3; ++i) {
+    worker.start([&sum, i] { sum += i; });
+    worker.wait();
+  }
+  EXPECT_EQ(sum, 6);
+}
+
+TEST(WorkerThreadTest, ALongNameIsCutToWhatAThreadHolds) {
+  WorkerThread worker("dp-a-name-longer-than-fifteen");
+  EXPECT_EQ(name_on(worker), std::string("dp-a-name-longer-than-fifteen").substr(0, 15));
+}
+
+}  // namespace
+}  // namespace downpour::sim
