@@ -4,6 +4,7 @@
 
 #include <cstring>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace downpour::sim {
@@ -15,8 +16,8 @@ void name_this_thread(const char* name) {
 }
 
 WorkerThread::WorkerThread(const char* name)
-    : thread_([this, name] {
-        name_this_thread(name);
+    : thread_([this, name = std::string(name)] {  // (a copy: the thread may start after we return)
+        name_this_thread(name.c_str());
         run();
       }) {}
 

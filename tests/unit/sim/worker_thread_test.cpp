@@ -1,5 +1,6 @@
-// The step's worker thread: its jobs run one at a time, and it carries the name it was given (what
-// `top -H` and perf show), cut to the 15 characters a thread name holds.
+// A worker thread (the step's, the CPU layers' helpers): its jobs run one at a time, and it carries
+// the name it was given (what `top -H` and perf show), cut to the 15 characters a thread name
+// holds.
 #include "server/sim/worker_thread.hpp"
 
 #include <pthread.h>
@@ -34,7 +35,8 @@ TEST(WorkerThreadTest, RunsItsJobsUnderItsName) {
 }
 
 TEST(WorkerThreadTest, ALongNameIsCutToWhatAThreadHolds) {
-  WorkerThread worker("dp-a-name-longer-than-fifteen");
+  // (Built where the worker is made and gone after: the thread keeps its own copy.)
+  WorkerThread worker(std::string("dp-a-name-longer-than-fifteen").c_str());
   EXPECT_EQ(name_on(worker), std::string("dp-a-name-longer-than-fifteen").substr(0, 15));
 }
 
