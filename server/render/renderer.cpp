@@ -425,6 +425,18 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
   if (target->fence[slot]) throw std::logic_error("readback slot reused before finish()");
 
   const Camera camera = make_camera(spec, scene.vehicle, &scene.weather);
+  // The passes drawn before the first that needs the step go to the rasterizer now, before this
+  // thread waits for the step: llvmpipe bins a frame's draws and rasterizes them only once they
+  // are flushed, so a core would otherwise idle through the wait (in the demo, a fifth of the
+  // tick).
+  bool flushed = false;
+  const StepSource step_after_flush = [&flushed, &stepped]() -> const sim::SceneState& {
+    if (!flushed) {
+      flushed = true;
+      glFlush();
+    }
+    return stepped();
+  };
   // Ground truth: the clean frame (for itself or the water mask) and the depth.
   const bool wants_clean = spec.outputs.needs_clean();
   if (spec.outputs.any() && !target->truth) {
@@ -438,7 +450,7 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
       atmosphere_from(scene.weather),
       glm::mat4(sim::vehicle_to_world(scene.vehicle)),
       GlassView(camera, scene.glass, spec.height, m.min_glass_layer_scale, m.glass_layer_widening),
-      stepped};
+      step_after_flush};
   frame.world = &m.worlds.get(scene.roads);
   frame.detail_distance_scale =
       detail_distance_scale(2.0 * camera.tan_half_fov_y / std::max(spec.height, 1));
