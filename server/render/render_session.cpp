@@ -17,6 +17,9 @@ void RenderSession::Impl::upload_glass_surface(
   static const auto dry = std::make_shared<const sim::GlassWaterSurface>();
   if (!surface) surface = dry;
   if (surface_shown != surface) {
+    // Into the set the last frames' draws did not read (kUploadCopies).
+    glass_current = (glass_current + 1) % glass_surface.size();
+    GlassSurfaceBuffers& set = glass_surface[glass_current];
     const std::array<std::pair<const void*, std::size_t>, 3> parts{{
         {surface->bodies.data(), surface->bodies.size() * sizeof(sim::WaterBody)},
         {surface->cells.data(), surface->cells.size() * sizeof(std::uint32_t)},
@@ -26,25 +29,26 @@ void RenderSession::Impl::upload_glass_surface(
     for (std::size_t k = 0; k < parts.size(); ++k) {
       // Grown as needed (never empty: a texture buffer needs storage), else refilled.
       const std::size_t bytes = std::max<std::size_t>(parts[k].second, 16);
-      if (!glass_surface[k].id() || glass_surface_bytes[k] < bytes) {
-        glass_surface[k] = make_buffer();
-        glass_surface_bytes[k] = std::max(bytes, 2 * glass_surface_bytes[k]);
-        glNamedBufferStorage(glass_surface[k].id(), static_cast<GLsizeiptr>(glass_surface_bytes[k]),
-                             nullptr, GL_DYNAMIC_STORAGE_BIT);
+      if (!set.buffer[k].id() || set.bytes[k] < bytes) {
+        set.buffer[k] = make_buffer();
+        set.bytes[k] = std::max(bytes, 2 * set.bytes[k]);
+        glNamedBufferStorage(set.buffer[k].id(), static_cast<GLsizeiptr>(set.bytes[k]), nullptr,
+                             GL_DYNAMIC_STORAGE_BIT);
         GLuint tex = 0;
         glCreateTextures(GL_TEXTURE_BUFFER, 1, &tex);
-        glass_surface_tex[k] = Texture(tex);
-        glTextureBuffer(tex, kFormats[k], glass_surface[k].id());
+        set.texture[k] = Texture(tex);
+        glTextureBuffer(tex, kFormats[k], set.buffer[k].id());
       }
       if (parts[k].second > 0)
-        glNamedBufferSubData(glass_surface[k].id(), 0, static_cast<GLsizeiptr>(parts[k].second),
+        glNamedBufferSubData(set.buffer[k].id(), 0, static_cast<GLsizeiptr>(parts[k].second),
                              parts[k].first);
     }
     surface_shown = surface;
   }
   const GLuint units[3] = {texture_unit::kGlassBodies, texture_unit::kGlassCells,
                            texture_unit::kGlassEntries};
-  for (std::size_t k = 0; k < 3; ++k) glBindTextureUnit(units[k], glass_surface_tex[k].id());
+  for (std::size_t k = 0; k < 3; ++k)
+    glBindTextureUnit(units[k], glass_surface[glass_current].texture[k].id());
 }
 
 GLuint RenderSession::Impl::upload_road_water(

@@ -19,11 +19,15 @@ namespace downpour::render {
 
 struct RenderSession::Impl {
   std::vector<std::unique_ptr<ViewTarget>> views;
-  // The water's surface on the glass (bodies, cells, entries: buffers, read as texture buffers) and
-  // what it holds.
-  std::array<Buffer, 3> glass_surface;
-  std::array<Texture, 3> glass_surface_tex;
-  std::array<std::size_t, 3> glass_surface_bytes{};
+  // The water's surface on the glass (bodies, cells, entries: buffers, read as texture buffers),
+  // in sets used in turn (kUploadCopies), and what the current set holds.
+  struct GlassSurfaceBuffers {
+    std::array<Buffer, 3> buffer;
+    std::array<Texture, 3> texture;
+    std::array<std::size_t, 3> bytes{};
+  };
+  std::array<GlassSurfaceBuffers, kUploadCopies> glass_surface;
+  std::size_t glass_current = 0;
   std::shared_ptr<const sim::GlassWaterSurface> surface_shown;
   // The world outside the glass, shared by the session's views (made on first use).
   std::unique_ptr<EnvironmentProbe> environment;

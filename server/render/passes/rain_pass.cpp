@@ -165,7 +165,7 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
   glBindTextureUnit(texture_unit::kRainLayer, texture.id());
   const std::vector<RainLayer::Bounds>& runs = layer.runs();
   const Buffer& buffer = sized.runs_buffer[sized.next];
-  sized.next = (sized.next + 1) % kUploadCopies;
+  sized.next = (sized.next + 1) % kLayerCopies;
   if (runs.empty()) return;
   // Only the tiles with rain: on llvmpipe the composite's cost is the area it covers, lit or not.
   runs_uv_.clear();

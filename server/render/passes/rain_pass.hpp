@@ -84,16 +84,17 @@ class RainPass final : public Pass {
   const std::vector<std::uint8_t>& cabin_tiles_for(const FrameContext& frame, int width,
                                                    int height);
   std::vector<CabinTiles> cabin_tiles_;
-  // What a layer size needs: the layer, and textures and run buffers used in turn
-  // (kUploadCopies, gl_objects.hpp). Kept per size for
-  // the latest few sizes (kSizesKept), so that sessions whose views differ in size, rendered in
-  // turn, re-create nothing; each layer has a helper thread of its own.
+  // What a layer size needs: the layer, and textures and run buffers used in turn, as many as
+  // kUploadCopies (gl_objects.hpp) for each of two views of that size in a tick (the demo's).
+  // Kept per size for the latest few sizes (kSizesKept), so that sessions whose views differ in
+  // size, rendered in turn, re-create nothing; each layer has a helper thread of its own.
   static constexpr std::size_t kSizesKept = 4;
+  static constexpr int kLayerCopies = 2 * kUploadCopies;
   struct Sized {
     int width = 0, height = 0;
     RainLayer layer;
-    Texture colour[kUploadCopies];
-    Buffer runs_buffer[kUploadCopies];  // the runs of tiles to draw, uv over the view (rain.vert)
+    Texture colour[kLayerCopies];
+    Buffer runs_buffer[kLayerCopies];  // the runs of tiles to draw, uv over the view (rain.vert)
     int next = 0;
   };
   Sized& sized(int width, int height);
