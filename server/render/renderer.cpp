@@ -54,6 +54,32 @@ std::size_t index(Resource r) { return static_cast<std::size_t>(r); }
 
 }  // namespace
 
+// A view between begin() and end(): its frame, its target, and where its passes stand.
+struct Renderer::ViewFrame::State {
+  State(const sim::SceneState& scene, const sim::ViewSpec& spec) : scene(scene), spec(spec) {}
+  const sim::SceneState& scene;
+  const sim::ViewSpec& spec;
+  RenderSession* session = nullptr;
+  RenderSession::Impl* targets = nullptr;  // the session's
+  int view_index = 0;
+  ViewTarget* target = nullptr;
+  int slot = 0;
+  std::optional<FrameContext> frame;
+  FrameResources resources;
+  Mirror mirror;
+  bool reflection = false;
+  bool fixed = false;  // COCKPIT before the fixed environment (tests)
+  bool wants_clean = false;
+  bool clean_taken = false;
+  bool lamp_map_stale = false;  // the lamp map holds another view's
+  const std::vector<Pass*>* passes = nullptr;
+  std::size_t next_pass = 0;  // the first of `passes` that end() draws
+  std::uint64_t begun = 0;    // its serial: Renderer::Impl::views_begun when it began
+  std::array<bool, kResourceCount> written{};
+  std::vector<PassTiming> timings;
+  bool ended = false;
+};
+
 struct Renderer::Impl {
   std::unique_ptr<EglContext> context;
   std::unique_ptr<SharedResources> shared;
@@ -82,6 +108,10 @@ struct Renderer::Impl {
   std::unique_ptr<RenderSession> image_session;  // render_image's
   bool view_drew_relief = false;   // the view's road pass (not the environment's faces)
   std::uint32_t rain_streaks = 0;  // drawn by the last render()
+  std::uint64_t views_begun = 0;
+  // The views (their serials) whose lamps, frame block and sky are set, and whose lamp map the
+  // lamp map pass holds.
+  std::uint64_t lamps_of = 0, lamp_map_of = 0;
 
   template <typename Fn>
   void timed(const std::string& name, Fn&& fn) {
@@ -285,6 +315,61 @@ struct Renderer::Impl {
     if (!d.state.colour_write) glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     for (Resource res : d.writes) written[index(res)] = true;
   }
+  // The passes a view draws before its own (none over a client's picture).
+  const std::vector<Pass*>& frame_passes(const sim::ViewSpec& spec) const {
+    static const std::vector<Pass*> kNone;
+    return spec.background == sim::Background::kClient ? kNone
+                                                       : passes.frame[static_cast<int>(spec.view)];
+  }
+
+  // The ground truth's clean frame: the view as it stands (before its water).
+  void take_clean(ViewFrame::State& v) {
+    timed("clean_copy", [&] {
+      glCopyImageSubData(v.target->colour.id(), GL_TEXTURE_2D, 0, 0, 0, 0,
+                         v.target->truth->clean.id(), GL_TEXTURE_2D, 0, 0, 0, 0, v.spec.width,
+                         v.spec.height, 1);
+    });
+    v.clean_taken = true;
+  }
+
+  // One of a view's passes, with what comes before it (the clean frame, the world outside the
+  // glass) and after it (the clean frame's blades).
+  void run_view_pass(ViewFrame::State& v, Pass* pass) {
+    FrameContext& frame = *v.frame;
+    RenderSession::Impl& s = *v.targets;
+    // The clean frame is the view before the first pass that adds water.
+    if (v.wants_clean && !v.clean_taken &&
+        std::find(passes.water.begin(), passes.water.end(), pass) != passes.water.end())
+      take_clean(v);
+    // The world outside the glass, for the first pass that reads it and has something to draw
+    // (it waits for the step, as that pass would).
+    const auto& reads = pass->decl().reads;
+    if (std::find(reads.begin(), reads.end(), Resource::kEnvironment) != reads.end() &&
+        pass->wanted(frame) && (v.fixed || has_water(frame.water()))) {
+      timed("glass_environment", [&] {
+        if (v.lamp_map_stale) {  // the faces' ground is lit by this view's lamp map
+          run_pass(*passes.lamp_map, frame, s, v.resources);
+          v.lamp_map_stale = false;
+          lamp_map_of = v.begun;
+        }
+        // render_image's pictures stand alone: their environment is drawn whole.
+        const bool picture = image_session && &s == image_session->impl_.get();
+        refresh_environment(frame, s, picture);
+      });
+    }
+    timed(pass->decl().name, [&] { run_pass(*pass, frame, s, v.resources); });
+    if (pass == passes.road) view_drew_relief = passes.road->drew_relief();
+    // The glass without its water keeps its blades.
+    if (v.wants_clean && pass == static_cast<Pass*>(passes.glass_composite) &&
+        pass->wanted(frame)) {
+      timed("clean_blades", [&] {
+        glBindFramebuffer(GL_FRAMEBUFFER, v.target->truth->clean_fbo.id());
+        apply(pass->decl().state);
+        passes.glass_composite->draw_blades(frame);
+        glBindFramebuffer(GL_FRAMEBUFFER, v.target->fbo.id());
+      });
+    }
+  }
 };
 
 Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -406,8 +491,19 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
                 [&scene]() -> const sim::SceneState& { return scene; });
 }
 
+Renderer::ViewFrame::ViewFrame(std::unique_ptr<State> state) : state_(std::move(state)) {}
+Renderer::ViewFrame::~ViewFrame() = default;
+
 PendingReadback Renderer::render(RenderSession& session, int view_index, const sim::ViewSpec& spec,
                                  const sim::SceneState& scene, const StepSource& stepped) {
+  const std::unique_ptr<ViewFrame> view = begin(session, view_index, spec, scene, stepped);
+  return end(*view);
+}
+
+std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int view_index,
+                                                     const sim::ViewSpec& spec,
+                                                     const sim::SceneState& scene,
+                                                     const StepSource& stepped) {
   Impl& m = *impl_;
   RenderSession::Impl& s = *session.impl_;
   m.timings.clear();
@@ -424,38 +520,33 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
   target->next_slot = (slot + 1) % kReadbackSlots;
   if (target->fence[slot]) throw std::logic_error("readback slot reused before finish()");
 
+  auto view = std::make_unique<ViewFrame::State>(scene, spec);
+  ViewFrame::State& v = *view;
+  v.session = &session;
+  v.targets = &s;
+  v.view_index = view_index;
+  v.target = target.get();
+  v.slot = slot;
+  v.begun = ++m.views_begun;
+  m.lamps_of = v.begun;
   const Camera camera = make_camera(spec, scene.vehicle, &scene.weather);
-  // The passes drawn before the first that needs the step go to the rasterizer now, before this
-  // thread waits for the step: llvmpipe bins a frame's draws and rasterizes them only once they
-  // are flushed, so a core would otherwise idle through the wait (in the demo, a fifth of the
-  // tick).
-  bool flushed = false;
-  const StepSource step_after_flush = [&flushed, &stepped]() -> const sim::SceneState& {
-    if (!flushed) {
-      flushed = true;
-      glFlush();
-    }
-    return stepped();
-  };
   // Ground truth: the clean frame (for itself or the water mask) and the depth.
-  const bool wants_clean = spec.outputs.needs_clean();
+  v.wants_clean = spec.outputs.needs_clean();
   if (spec.outputs.any() && !target->truth) {
     target->truth =
         std::make_unique<GroundTruthTarget>(spec.width, spec.height, target->depth.id());
   }
-  FrameContext frame{
-      scene,
-      spec,
-      camera,
-      atmosphere_from(scene.weather),
+  v.frame.emplace(FrameContext{
+      scene, spec, camera, atmosphere_from(scene.weather),
       glm::mat4(sim::vehicle_to_world(scene.vehicle)),
       GlassView(camera, scene.glass, spec.height, m.min_glass_layer_scale, m.glass_layer_widening),
-      step_after_flush};
+      stepped});
+  FrameContext& frame = *v.frame;
   frame.world = &m.worlds.get(scene.roads);
   frame.detail_distance_scale =
       detail_distance_scale(2.0 * camera.tan_half_fov_y / std::max(spec.height, 1));
   if (new_target) m.prepare(frame);
-  FrameResources resources;
+  FrameResources& resources = v.resources;
   resources.view_fbo = target->fbo.id();
   resources.view_colour = {target->colour.id(), spec.width, spec.height};
   resources.view_depth = {target->depth.id(), spec.width, spec.height};
@@ -469,64 +560,65 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
   ++m.frame;
   m.transients.evict();
   m.written.fill(false);
-  const int view = static_cast<int>(spec.view);
-  static const std::vector<Pass*> kNone;
   const bool client = spec.background == sim::Background::kClient;
-  const std::vector<Pass*>& frame_passes = client ? kNone : m.passes.frame[view];
-  const bool reflection =
-      lists(frame_passes, m.passes.reflection) && m.passes.reflection->wanted(frame);
+  const std::vector<Pass*>& frame_passes = m.frame_passes(spec);
+  v.reflection = lists(frame_passes, m.passes.reflection) && m.passes.reflection->wanted(frame);
   // Profiling: the clears and the frame's uploads finish here, not in the first step's time.
   if (m.profiling) m.timed("clear", [] {});
   m.timed("lamps", [&] {
     m.lamps->prepare(frame, m.lamps_on, lists(frame_passes, m.passes.lamp_map));
     m.block->set_lamps(m.lamps->fields());
   });
-  const Mirror mirror =
-      mirror_under(scene.roads ? *scene.roads : *sim::built_in_roads(), scene.vehicle);
-  m.block->upload_view(frame, water_block(frame, mirror, reflection));
+  v.mirror = mirror_under(scene.roads ? *scene.roads : *sim::built_in_roads(), scene.vehicle);
+  m.block->upload_view(frame, water_block(frame, v.mirror, v.reflection));
   m.sky->show(frame.atmosphere);
   for (Pass* pass : frame_passes)
     m.timed(pass->decl().name, [&] { m.run_pass(*pass, frame, s, resources); });
-  const bool fixed = m.fixed_environment && spec.view == sim::View::kCockpit && !client;
-  m.passes.rain->take_drawn();
-  bool clean_taken = false;
-  auto take_clean = [&] {
-    m.timed("clean_copy", [&] {
-      glCopyImageSubData(target->colour.id(), GL_TEXTURE_2D, 0, 0, 0, 0, target->truth->clean.id(),
-                         GL_TEXTURE_2D, 0, 0, 0, 0, spec.width, spec.height, 1);
+  if (lists(frame_passes, m.passes.lamp_map)) m.lamp_map_of = v.begun;
+  v.fixed = m.fixed_environment && spec.view == sim::View::kCockpit && !client;
+  v.passes = v.fixed ? &m.passes.fixed_environment_cockpit : &m.view_list(spec);
+  // The passes that need only the frame's inputs: those before the first that reads the step.
+  while (v.next_pass < v.passes->size() && !(*v.passes)[v.next_pass]->decl().reads_step)
+    m.run_view_pass(v, (*v.passes)[v.next_pass++]);
+  // To the rasterizer now, before this thread waits for the step or draws another view:
+  // llvmpipe bins a frame's draws and rasterizes them only once they are flushed, so a core would
+  // otherwise idle through the wait (in the demo, a fifth of the tick).
+  glFlush();
+  v.written = m.written;
+  v.timings = std::move(m.timings);
+  m.timings.clear();
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  return std::unique_ptr<ViewFrame>(new ViewFrame(std::move(view)));
+}
+
+PendingReadback Renderer::end(ViewFrame& view) {
+  Impl& m = *impl_;
+  ViewFrame::State& v = *view.state_;
+  if (v.ended) throw std::logic_error("a view ended twice");
+  v.ended = true;
+  FrameContext& frame = *v.frame;
+  const sim::ViewSpec& spec = v.spec;
+  ViewTarget& target = *v.target;
+  m.written = v.written;
+  m.timings = std::move(v.timings);
+  glBindFramebuffer(GL_FRAMEBUFFER, target.fbo.id());
+  glViewport(0, 0, spec.width, spec.height);
+  // Another view began or ended since this one began: this one's lamps, blocks and sky again;
+  // its lamp map only if a face of the environment is drawn (run_view_pass).
+  const std::vector<Pass*>& frame_passes = m.frame_passes(spec);
+  if (m.lamps_of != v.begun) {
+    m.timed("lamps", [&] {
+      m.lamps->prepare(frame, m.lamps_on, lists(frame_passes, m.passes.lamp_map));
+      m.block->set_lamps(m.lamps->fields());
     });
-    clean_taken = true;
-  };
-  for (Pass* pass : fixed ? m.passes.fixed_environment_cockpit : m.view_list(spec)) {
-    // The clean frame is the view before the first pass that adds water.
-    if (wants_clean && !clean_taken &&
-        std::find(m.passes.water.begin(), m.passes.water.end(), pass) != m.passes.water.end())
-      take_clean();
-    // The world outside the glass, for the first pass that reads it and has something to draw
-    // (it waits for the step, as that pass would).
-    const auto& reads = pass->decl().reads;
-    if (std::find(reads.begin(), reads.end(), Resource::kEnvironment) != reads.end() &&
-        pass->wanted(frame) && (fixed || has_water(frame.water()))) {
-      m.timed("glass_environment", [&] {
-        // render_image's pictures stand alone: their environment is drawn whole.
-        const bool picture = m.image_session && &s == m.image_session->impl_.get();
-        m.refresh_environment(frame, s, picture);
-      });
-    }
-    m.timed(pass->decl().name, [&] { m.run_pass(*pass, frame, s, resources); });
-    if (pass == m.passes.road) m.view_drew_relief = m.passes.road->drew_relief();
-    // The glass without its water keeps its blades.
-    if (wants_clean && pass == static_cast<Pass*>(m.passes.glass_composite) &&
-        pass->wanted(frame)) {
-      m.timed("clean_blades", [&] {
-        glBindFramebuffer(GL_FRAMEBUFFER, target->truth->clean_fbo.id());
-        apply(pass->decl().state);
-        m.passes.glass_composite->draw_blades(frame);
-        glBindFramebuffer(GL_FRAMEBUFFER, target->fbo.id());
-      });
-    }
+    m.block->upload_view(frame, water_block(frame, v.mirror, v.reflection));
+    m.sky->show(frame.atmosphere);
+    m.lamps_of = v.begun;
   }
-  if (wants_clean && !clean_taken) take_clean();  // a view that adds no water
+  v.lamp_map_stale = lists(frame_passes, m.passes.lamp_map) && m.lamp_map_of != v.begun;
+  m.passes.rain->take_drawn();
+  while (v.next_pass < v.passes->size()) m.run_view_pass(v, (*v.passes)[v.next_pass++]);
+  if (v.wants_clean && !v.clean_taken) m.take_clean(v);  // a view that adds no water
   const RainPass::Drawn rain = m.passes.rain->take_drawn();
   m.rain_streaks = rain.streaks;
   // The rain pass's CPU layer, beside the whole pass, for the budget table.
@@ -542,28 +634,29 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
     throw std::runtime_error(text);
   }
 
-  PendingReadback pending{&session,   view_index,  slot,         nullptr,
-                          spec.width, spec.height, spec.outputs, camera.near_m};
+  const int slot = v.slot;
+  PendingReadback pending{v.session,  v.view_index, slot,         nullptr,
+                          spec.width, spec.height,  spec.outputs, frame.camera.near_m};
   m.timed("readback_start", [&] {
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glNamedFramebufferReadBuffer(target->fbo.id(), GL_COLOR_ATTACHMENT0);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, target->fbo.id());
-    glBindBuffer(GL_PIXEL_PACK_BUFFER, target->pbo[slot].id());
+    glNamedFramebufferReadBuffer(target.fbo.id(), GL_COLOR_ATTACHMENT0);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, target.fbo.id());
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, target.pbo[slot].id());
     glReadPixels(0, 0, spec.width, spec.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
     if (spec.outputs.depth) {
-      glBindBuffer(GL_PIXEL_PACK_BUFFER, target->truth->depth_pbo[slot].id());
+      glBindBuffer(GL_PIXEL_PACK_BUFFER, target.truth->depth_pbo[slot].id());
       glReadPixels(0, 0, spec.width, spec.height, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
     }
-    if (wants_clean) {
-      glNamedFramebufferReadBuffer(target->truth->clean_fbo.id(), GL_COLOR_ATTACHMENT0);
-      glBindFramebuffer(GL_READ_FRAMEBUFFER, target->truth->clean_fbo.id());
-      glBindBuffer(GL_PIXEL_PACK_BUFFER, target->truth->clean_pbo[slot].id());
+    if (v.wants_clean) {
+      glNamedFramebufferReadBuffer(target.truth->clean_fbo.id(), GL_COLOR_ATTACHMENT0);
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, target.truth->clean_fbo.id());
+      glBindBuffer(GL_PIXEL_PACK_BUFFER, target.truth->clean_pbo[slot].id());
       glReadPixels(0, 0, spec.width, spec.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
     }
     glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     glFlush();
-    target->fence[slot] = fence;
+    target.fence[slot] = fence;
     pending.fence = fence;
   });
   glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -120,6 +120,27 @@ class Renderer {
   // are not read); `stepped` gives the state after the step when a pass needs it.
   PendingReadback render(RenderSession& session, int view_index, const sim::ViewSpec& spec,
                          const sim::SceneState& scene, const StepSource& stepped);
+  // render() in two halves, so that a tick's views overlap: begin() draws the passes that need
+  // only the frame's inputs and hands them to the rasterizer, end() the rest (the rain, the
+  // spray, the glass) and starts the readback. Between them other views may begin or end; each
+  // view begun is ended once, or dropped (then its frame is lost, and its target kept). `spec`,
+  // `scene` and `stepped` must live until end().
+  class ViewFrame {
+   public:
+    ~ViewFrame();
+    ViewFrame(const ViewFrame&) = delete;
+    ViewFrame& operator=(const ViewFrame&) = delete;
+
+   private:
+    friend class Renderer;
+    struct State;
+    explicit ViewFrame(std::unique_ptr<State> state);
+    std::unique_ptr<State> state_;
+  };
+  std::unique_ptr<ViewFrame> begin(RenderSession& session, int view_index,
+                                   const sim::ViewSpec& spec, const sim::SceneState& scene,
+                                   const StepSource& stepped);
+  PendingReadback end(ViewFrame& view);
   // The same with the scene's own windshield and rain.
   PendingReadback render(RenderSession& session, int view_index, const sim::ViewSpec& spec,
                          const sim::SceneState& scene);

@@ -405,12 +405,20 @@ void FrameScheduler::tick(const std::shared_ptr<Session>& s, const StartedStep& 
     if (!targets) targets = renderer_->open_session();
     // The same air for every view of the tick.
     const double visibility_m = render::visibility_m(render::atmosphere_from(inputs.weather));
+    // Every view's passes that need only the inputs first, then the rest of each: one view's
+    // wait for the step and its CPU work (the rain layer) overlap the others' rasterizing.
+    std::vector<std::unique_ptr<render::Renderer::ViewFrame>> begun;
+    std::vector<double> begin_ms;
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      const Clock::time_point t0 = Clock::now();
+      begun.push_back(renderer_->begin(*targets, static_cast<int>(i), views[i], inputs, water));
+      begin_ms.push_back(ms_since(t0));
+    }
     for (std::size_t i = 0; i < views.size(); ++i) {
       const Clock::time_point t0 = Clock::now();
       InFlight f;
-      const render::PendingReadback readback =
-          renderer_->render(*targets, static_cast<int>(i), views[i], inputs, water);
-      f.render_ms = ms_since(t0);
+      const render::PendingReadback readback = renderer_->end(*begun[i]);
+      f.render_ms = begin_ms[i] + ms_since(t0);
       f.rain_streaks = renderer_->last_rain_streaks();
       if (views[i].background == sim::Background::kClient) {
         f.background_repeats = s->note_background(

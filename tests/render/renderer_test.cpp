@@ -1,7 +1,10 @@
 // Render tests on llvmpipe: each view against a golden PNG, and properties a golden file cannot
 // fake. Set DOWNPOUR_UPDATE_GOLDEN=1 to rewrite the golden files after a deliberate change (then
 // look at them).
+#include <array>
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -90,6 +93,43 @@ TEST_F(RendererTest, DryWindshieldViewIsTheOutlineOnBlack) {
   const int total = kWidth * kHeight;
   EXPECT_GT(lit, total / 200);  // the outline is there
   EXPECT_LT(lit, total / 10);   // and nothing else: no water on dry glass
+}
+
+// A tick's views begun together and then ended (as the scheduler draws them, so that they
+// overlap) give the pixels that rendering them one at a time gives, by day and at night (where
+// each view's lamps, and the lamp map under the glass's environment, are its own again).
+TEST_F(RendererTest, ViewsBegunTogetherDrawAsOneAtATime) {
+  sim::SceneState day = highway_scene();
+  sim::SceneState night = day;
+  night.weather.sun_altitude_deg = -20.0;
+  night.weather.cloudiness = 0.0;
+  night.weather.fog_density = 0.0;
+  night.ego_lights.headlights = sim::Headlights::kLow;
+  const std::array<sim::ViewSpec, 2> specs = {view_spec(sim::View::kCockpit, kWidth, kHeight),
+                                              view_spec(sim::View::kRoad, kWidth, kHeight)};
+  for (const sim::SceneState* scene : {&day, &night}) {
+    const StepSource stepped = [scene]() -> const sim::SceneState& { return *scene; };
+    auto pixels = [&](const PendingReadback& pending) {
+      std::vector<std::uint8_t> out;
+      renderer().finish(pending, out);
+      return out;
+    };
+    const std::unique_ptr<RenderSession> alone = renderer().open_session();
+    std::array<std::vector<std::uint8_t>, 2> one_at_a_time;
+    for (int v = 0; v < 2; ++v)
+      one_at_a_time[v] = pixels(renderer().render(*alone, v, specs[v], *scene, stepped));
+    const std::unique_ptr<RenderSession> together = renderer().open_session();
+    std::array<std::unique_ptr<Renderer::ViewFrame>, 2> begun;
+    for (int v = 0; v < 2; ++v)
+      begun[v] = renderer().begin(*together, v, specs[v], *scene, stepped);
+    for (int v = 0; v < 2; ++v) {
+      const std::vector<std::uint8_t> overlapped = pixels(renderer().end(*begun[v]));
+      ASSERT_EQ(overlapped.size(), one_at_a_time[v].size());
+      EXPECT_TRUE(overlapped == one_at_a_time[v])
+          << sim::view_name(specs[v].view) << (scene == &night ? " at night" : " by day")
+          << " differs when begun beside another view";
+    }
+  }
 }
 
 TEST_F(RendererTest, SameSceneRendersTheSamePixels) {
