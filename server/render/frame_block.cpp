@@ -48,6 +48,7 @@ WaterBlock water_block(const FrameContext& f, const Mirror& mirror, bool reflect
   w.road_water.w = reflection ? 1.0f : 0.0f;
   if (const sim::RoadWaterImage* image = f.scene.road_water.get(); image && image->complete()) {
     w.road_water.x = static_cast<float>(image->levels);
+    w.road_water.y = static_cast<float>(image->cells) / 4.0f;
     for (int l = 0; l < image->levels; ++l) {
       const double cell = image->level_cell_m(l);
       w.road_water_rings[l] =

@@ -89,7 +89,9 @@ namespace downpour::render {
   X(vec4, wind, "xy wind velocity (m/s, world)")                                              \
   X(mat4, mirror_view_proj, "world to the reflection's clip: view_proj times the mirror")     \
   X(vec4, clip_plane, "what is drawn: n.p + w >= 0 (the road reflection's, else everything)") \
-  X(vec4, road_water, "x the water's rings (0: none), w 1 with a reflection drawn, else 0")   \
+  X(vec4, road_water,                                                                         \
+    "x the water's rings (0: none), y a ring's cells a side over 4 (its fading band: 4 "      \
+    "cells), w 1 with a reflection drawn, else 0")                                            \
   X(mat4, road_water_rings,                                                                   \
     "column l: ring l's window, xy its lower-left corner (world m), z 1 / its side (m), "     \
     "w its cell (m)")                                                                         \
