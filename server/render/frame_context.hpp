@@ -35,7 +35,7 @@ struct FrameContext {
   glm::mat4 vehicle_to_world{1.0f};
   GlassView glass;  // where the view meets the windshield, and how sharply it sees the glass
   // The state after this frame's step; waits for the step. Only passes that declare
-  // PassDecl::reads_step call it (through water() and rain()).
+  // PassDecl::reads_step call it (through water()).
   std::function<const sim::SceneState&()> stepped;
   // Chunked geometry takes its level of detail as from this many times as far: a view's pixel
   // angle over that of COCKPIT at 720 rows (detail_distance_scale()), the geometry's levels'
@@ -56,7 +56,13 @@ struct FrameContext {
   const Camera& picture_camera_or_own() const { return picture_camera ? *picture_camera : camera; }
 
   const sim::WindshieldState& water() const { return stepped().windshield; }
-  const sim::RainState& rain() const { return stepped().rain; }
+  // The rain: the inputs' (the last step's drops, which the rain layer moves on to the frame's
+  // time), not the step's, so that the rain need not wait for the step; but before the first step
+  // (no rain published yet: a session's first frame) the step's.
+  const sim::RainState& rain() const {
+    const bool published = !scene.rain.drops.empty() || scene.rain.time_s > 0.0;
+    return published ? scene.rain : stepped().rain;
+  }
 };
 
 // A program that lights with the lamps (common.glsl's lamp_ground, ego_headlights,

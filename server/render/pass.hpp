@@ -27,7 +27,7 @@ struct PassDecl {
   std::vector<Resource> reads;   // bound to their texture units before the pass runs
   std::vector<Resource> writes;  // one target: the view (colour and/or depth), or a transient
   RenderState state;             // applied before the pass runs
-  bool reads_step = false;       // calls FrameContext::water() or rain(): the state after the step
+  bool reads_step = false;       // calls FrameContext::water(): the state after the step
   // Every other state the pass draws under, in the order it draws them (Pass::apply_step).
   std::vector<PassStep> steps = {};
 };

@@ -77,6 +77,7 @@ struct Renderer::ViewFrame::State {
   std::uint64_t begun = 0;    // its serial: Renderer::Impl::views_begun when it began
   std::array<bool, kResourceCount> written{};
   std::vector<PassTiming> timings;
+  RainPass::Drawn rain;  // what its rain pass drew (in begin())
   bool ended = false;
 };
 
@@ -578,12 +579,14 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
   v.fixed = m.fixed_environment && spec.view == sim::View::kCockpit && !client;
   v.passes = v.fixed ? &m.passes.fixed_environment_cockpit : &m.view_list(spec);
   // The passes that need only the frame's inputs: those before the first that reads the step.
+  m.passes.rain->take_drawn();
   while (v.next_pass < v.passes->size() && !(*v.passes)[v.next_pass]->decl().reads_step)
     m.run_view_pass(v, (*v.passes)[v.next_pass++]);
   // To the rasterizer now, before this thread waits for the step or draws another view:
   // llvmpipe bins a frame's draws and rasterizes them only once they are flushed, so a core would
   // otherwise idle through the wait (in the demo, a fifth of the tick).
   glFlush();
+  v.rain = m.passes.rain->take_drawn();
   v.written = m.written;
   v.timings = std::move(m.timings);
   m.timings.clear();
@@ -619,7 +622,8 @@ PendingReadback Renderer::end(ViewFrame& view) {
   m.passes.rain->take_drawn();
   while (v.next_pass < v.passes->size()) m.run_view_pass(v, (*v.passes)[v.next_pass++]);
   if (v.wants_clean && !v.clean_taken) m.take_clean(v);  // a view that adds no water
-  const RainPass::Drawn rain = m.passes.rain->take_drawn();
+  RainPass::Drawn rain = m.passes.rain->take_drawn();
+  if (rain.streaks == 0) rain = v.rain;
   m.rain_streaks = rain.streaks;
   // The rain pass's CPU layer, beside the whole pass, for the budget table.
   if (m.profiling && rain.streaks > 0) m.timings.push_back({"rain_layer", rain.layer_ms});

@@ -116,13 +116,13 @@ class Renderer {
   std::unique_ptr<RenderSession> open_session();
 
   // Renders a session's view `view_index` (its target made on first use, remade when the size
-  // changes) and starts its readback. `scene` holds the frame's inputs (its windshield and rain
-  // are not read); `stepped` gives the state after the step when a pass needs it.
+  // changes) and starts its readback. `scene` holds the frame's inputs, the rain drawn among them
+  // (its windshield is not read); `stepped` gives the state after the step when a pass needs it.
   PendingReadback render(RenderSession& session, int view_index, const sim::ViewSpec& spec,
                          const sim::SceneState& scene, const StepSource& stepped);
   // render() in two halves, so that a tick's views overlap: begin() draws the passes that need
-  // only the frame's inputs and hands them to the rasterizer, end() the rest (the rain, the
-  // spray, the glass) and starts the readback. Between them other views may begin or end; each
+  // only the frame's inputs (all but the glass's) and hands them to the rasterizer, end() the
+  // rest and starts the readback. Between them other views may begin or end; each
   // view begun is ended once, or dropped (then its frame is lost, and its target kept). `spec`,
   // `scene` and `stepped` must live until end().
   class ViewFrame {

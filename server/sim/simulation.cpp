@@ -186,6 +186,9 @@ SceneState Simulation::inputs_after(double dt_s) const {
   // The spray as the last step left it, likewise: its parcels are placed in the world, and a frame
   // old they still are where they were (the views need not wait for the step).
   inputs.spray = state_.spray;
+  // The rain as the last step left it: the views draw its drops moved on to the frame's time
+  // (RainLayerInputs::dt_s), so that no pass waits for the step for them.
+  inputs.rain = state_.rain;
   inputs.sub_steps = state_.sub_steps;
   for (double carry = carry_s_ + dt_s; whole_sub_step_due(carry); carry -= config_.sub_step_s)
     ++inputs.sub_steps;

@@ -94,7 +94,8 @@ class Simulation {
   void apply(const Update& update);
   // Advances by dt in whole sub-steps; the remainder carries into the next call.
   void advance(double dt_s);
-  // The state as advance(dt_s) will leave it but for the windshield (left empty): the inputs and
+  // The state as advance(dt_s) will leave it but for the windshield (left empty) and the rain (the
+  // last step's, whose drops the rain layer moves on to the time after the step): the inputs and
   // the time after the step, for what can be drawn while the step runs.
   SceneState inputs_after(double dt_s) const;
 

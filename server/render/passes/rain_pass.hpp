@@ -61,7 +61,7 @@ class RainPass final : public Pass {
       {},
       {Resource::kViewColour, Resource::kViewDepth},
       {DepthTest::kOff, false, Blend::kPremultiplied},
-      true,
+      false,
       {{"clear tiles", {DepthTest::kOff, false, Blend::kPremultiplied}},
        {"cabin tiles", {DepthTest::kNearer, false, Blend::kPremultiplied, true, true}}}};
   SharedResources& shared_;
