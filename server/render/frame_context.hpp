@@ -34,8 +34,8 @@ struct FrameContext {
   Atmosphere atmosphere;
   glm::mat4 vehicle_to_world{1.0f};
   GlassView glass;  // where the view meets the windshield, and how sharply it sees the glass
-  // The state after this frame's step; waits for the step. Only passes that declare
-  // PassDecl::reads_step call it (through water()).
+  // The state after this frame's step; waits for the step. Passes that declare
+  // PassDecl::reads_step call it (through water()); rain() only on a session's first frame.
   std::function<const sim::SceneState&()> stepped;
   // Chunked geometry takes its level of detail as from this many times as far: a view's pixel
   // angle over that of COCKPIT at 720 rows (detail_distance_scale()), the geometry's levels'

@@ -27,7 +27,8 @@ struct PassDecl {
   std::vector<Resource> reads;   // bound to their texture units before the pass runs
   std::vector<Resource> writes;  // one target: the view (colour and/or depth), or a transient
   RenderState state;             // applied before the pass runs
-  bool reads_step = false;       // calls FrameContext::water(): the state after the step
+  bool reads_step = false;       // calls FrameContext::water(): the state after the step (rain()
+                                 // waits for it only before any rain is published)
   // Every other state the pass draws under, in the order it draws them (Pass::apply_step).
   std::vector<PassStep> steps = {};
 };

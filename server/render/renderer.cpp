@@ -52,6 +52,19 @@ bool lists(const std::vector<Pass*>& passes, const Pass* pass) {
 
 std::size_t index(Resource r) { return static_cast<std::size_t>(r); }
 
+// A GL error (out of memory for a large target, a lost context) fails the view's frame, and with
+// it only its session (the scheduler's boundary).
+void throw_gl_error(sim::View view) {
+  const GLenum error = glGetError();
+  if (error == GL_NO_ERROR) return;
+  char text[64];
+  std::snprintf(text, sizeof text, "GL error 0x%04x rendering the %s view", error,
+                std::string(sim::view_name(view)).c_str());
+  for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) {
+  }  // bounded: a lost context may report itself on every call
+  throw std::runtime_error(text);
+}
+
 }  // namespace
 
 // A view between begin() and end(): its frame, its target, and where its passes stand.
@@ -586,6 +599,7 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
   // llvmpipe bins a frame's draws and rasterizes them only once they are flushed, so a core would
   // otherwise idle through the wait (in the demo, a fifth of the tick).
   glFlush();
+  throw_gl_error(spec.view);  // this view's, not the next one's to check
   v.rain = m.passes.rain->take_drawn();
   v.written = m.written;
   v.timings = std::move(m.timings);
@@ -627,16 +641,7 @@ PendingReadback Renderer::end(ViewFrame& view) {
   m.rain_streaks = rain.streaks;
   // The rain pass's CPU layer, beside the whole pass, for the budget table.
   if (m.profiling && rain.streaks > 0) m.timings.push_back({"rain_layer", rain.layer_ms});
-  // A GL error here (out of memory for a large target, a lost context) fails this view's frame,
-  // and with it only its session (the scheduler's boundary).
-  if (const GLenum error = glGetError(); error != GL_NO_ERROR) {
-    char text[64];
-    std::snprintf(text, sizeof text, "GL error 0x%04x rendering the %s view", error,
-                  std::string(sim::view_name(spec.view)).c_str());
-    for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) {
-    }  // bounded: a lost context may report itself on every call
-    throw std::runtime_error(text);
-  }
+  throw_gl_error(spec.view);
 
   const int slot = v.slot;
   PendingReadback pending{v.session,  v.view_index, slot,         nullptr,

@@ -123,8 +123,9 @@ class Renderer {
   // render() in two halves, so that a tick's views overlap: begin() draws the passes that need
   // only the frame's inputs (all but the glass's) and hands them to the rasterizer, end() the
   // rest and starts the readback. Between them other views may begin or end; each
-  // view begun is ended once, or dropped (then its frame is lost, and its target kept). `spec`,
-  // `scene` and `stepped` must live until end().
+  // view begun is ended once, or dropped (then its frame is lost, and its target kept). `session`,
+  // `spec`, `scene` and `stepped` must live until end(). (A session's first frame waits for the
+  // step in begin(): no rain has been published before it.)
   class ViewFrame {
    public:
     ~ViewFrame();
