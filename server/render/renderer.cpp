@@ -69,8 +69,7 @@ void throw_gl_error(sim::View view) {
 
 // A view between begin() and end(): its frame, its target, and where its passes stand.
 struct Renderer::ViewFrame::State {
-  State(const sim::SceneState& scene, const sim::ViewSpec& spec) : scene(scene), spec(spec) {}
-  const sim::SceneState& scene;
+  explicit State(const sim::ViewSpec& spec) : spec(spec) {}
   const sim::ViewSpec& spec;
   RenderSession* session = nullptr;
   RenderSession::Impl* targets = nullptr;  // the session's
@@ -534,7 +533,7 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
   target->next_slot = (slot + 1) % kReadbackSlots;
   if (target->fence[slot]) throw std::logic_error("readback slot reused before finish()");
 
-  auto view = std::make_unique<ViewFrame::State>(scene, spec);
+  auto view = std::make_unique<ViewFrame::State>(spec);
   ViewFrame::State& v = *view;
   v.session = &session;
   v.targets = &s;
