@@ -72,7 +72,6 @@ struct Renderer::ViewFrame::State {
   explicit State(const sim::ViewSpec& spec) : spec(spec) {}
   const sim::ViewSpec& spec;
   RenderSession* session = nullptr;
-  RenderSession::Impl* targets = nullptr;  // the session's
   int view_index = 0;
   ViewTarget* target = nullptr;
   int slot = 0;
@@ -328,6 +327,19 @@ struct Renderer::Impl {
     if (!d.state.colour_write) glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     for (Resource res : d.writes) written[index(res)] = true;
   }
+  // What view v's passes read of the renderer's own: its lamps (FrameLamps, and the frame block's
+  // share), its frame block and its sky.
+  void set_view(ViewFrame::State& v) {
+    FrameContext& frame = *v.frame;
+    timed("lamps", [&] {
+      lamps->prepare(frame, lamps_on, lists(frame_passes(v.spec), passes.lamp_map));
+      block->set_lamps(lamps->fields());
+    });
+    block->upload_view(frame, water_block(frame, v.mirror, v.reflection));
+    sky->show(frame.atmosphere);
+    lamps_of = v.begun;
+  }
+
   // The passes a view draws before its own (none over a client's picture).
   const std::vector<Pass*>& frame_passes(const sim::ViewSpec& spec) const {
     static const std::vector<Pass*> kNone;
@@ -349,7 +361,7 @@ struct Renderer::Impl {
   // glass) and after it (the clean frame's blades).
   void run_view_pass(ViewFrame::State& v, Pass* pass) {
     FrameContext& frame = *v.frame;
-    RenderSession::Impl& s = *v.targets;
+    RenderSession::Impl& s = *v.session->impl_;
     // The clean frame is the view before the first pass that adds water.
     if (v.wants_clean && !v.clean_taken &&
         std::find(passes.water.begin(), passes.water.end(), pass) != passes.water.end())
@@ -536,12 +548,10 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
   auto view = std::make_unique<ViewFrame::State>(spec);
   ViewFrame::State& v = *view;
   v.session = &session;
-  v.targets = &s;
   v.view_index = view_index;
   v.target = target.get();
   v.slot = slot;
   v.begun = ++m.views_begun;
-  m.lamps_of = v.begun;
   const Camera camera = make_camera(spec, scene.vehicle, &scene.weather);
   // Ground truth: the clean frame (for itself or the water mask) and the depth.
   v.wants_clean = spec.outputs.needs_clean();
@@ -578,13 +588,8 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
   v.reflection = lists(frame_passes, m.passes.reflection) && m.passes.reflection->wanted(frame);
   // Profiling: the clears and the frame's uploads finish here, not in the first step's time.
   if (m.profiling) m.timed("clear", [] {});
-  m.timed("lamps", [&] {
-    m.lamps->prepare(frame, m.lamps_on, lists(frame_passes, m.passes.lamp_map));
-    m.block->set_lamps(m.lamps->fields());
-  });
   v.mirror = mirror_under(scene.roads ? *scene.roads : *sim::built_in_roads(), scene.vehicle);
-  m.block->upload_view(frame, water_block(frame, v.mirror, v.reflection));
-  m.sky->show(frame.atmosphere);
+  m.set_view(v);
   for (Pass* pass : frame_passes)
     m.timed(pass->decl().name, [&] { m.run_pass(*pass, frame, s, resources); });
   if (lists(frame_passes, m.passes.lamp_map)) m.lamp_map_of = v.begun;
@@ -619,24 +624,17 @@ PendingReadback Renderer::end(ViewFrame& view) {
   m.timings = std::move(v.timings);
   glBindFramebuffer(GL_FRAMEBUFFER, target.fbo.id());
   glViewport(0, 0, spec.width, spec.height);
-  // Another view began or ended since this one began: this one's lamps, blocks and sky again;
-  // its lamp map only if a face of the environment is drawn (run_view_pass).
-  const std::vector<Pass*>& frame_passes = m.frame_passes(spec);
-  if (m.lamps_of != v.begun) {
-    m.timed("lamps", [&] {
-      m.lamps->prepare(frame, m.lamps_on, lists(frame_passes, m.passes.lamp_map));
-      m.block->set_lamps(m.lamps->fields());
-    });
-    m.block->upload_view(frame, water_block(frame, v.mirror, v.reflection));
-    m.sky->show(frame.atmosphere);
-    m.lamps_of = v.begun;
+  // Passes left to draw (the glass's) after another view began or ended since this one began:
+  // this one's lamps, blocks and sky again; its lamp map only if a face of the environment is
+  // drawn (run_view_pass). A view with none left (ROAD) only starts its readback.
+  if (v.next_pass < v.passes->size()) {
+    if (m.lamps_of != v.begun) m.set_view(v);
+    v.lamp_map_stale = lists(m.frame_passes(spec), m.passes.lamp_map) && m.lamp_map_of != v.begun;
   }
-  v.lamp_map_stale = lists(frame_passes, m.passes.lamp_map) && m.lamp_map_of != v.begun;
-  m.passes.rain->take_drawn();
   while (v.next_pass < v.passes->size()) m.run_view_pass(v, (*v.passes)[v.next_pass++]);
   if (v.wants_clean && !v.clean_taken) m.take_clean(v);  // a view that adds no water
-  RainPass::Drawn rain = m.passes.rain->take_drawn();
-  if (rain.streaks == 0) rain = v.rain;
+  // (The rain pass reads no step: it is drawn in begin().)
+  const RainPass::Drawn& rain = v.rain;
   m.rain_streaks = rain.streaks;
   // The rain pass's CPU layer, beside the whole pass, for the budget table.
   if (m.profiling && rain.streaks > 0) m.timings.push_back({"rain_layer", rain.layer_ms});
