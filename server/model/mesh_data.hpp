@@ -1,6 +1,7 @@
 // Geometry built on the CPU (no GL): vertices and indices with their bounds, ready for upload.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -78,6 +79,18 @@ struct MeshData {
   // top_lo..top_hi (x, y) at z = hi.z.
   void add_frustum(const glm::vec3& lo, const glm::vec3& hi, const glm::vec2& top_lo,
                    const glm::vec2& top_hi, float material);
+};
+
+// Chunks that tile a surface as a grid, each at levels of detail (levels[c][k], k = 0 the finest;
+// chunked_mesh.hpp draws them), with skirts apart: at each level, a strip hanging from each of the
+// chunk's edges, south, north, west and east (skirts[c][k][edge]). Two chunks drawn at one level
+// share their edge's vertices; only where the chunk across an edge (across[c][edge], -1 at the
+// surface's border) is drawn at another level do the edges differ and a crack open, and only there
+// is the skirt drawn.
+struct SkirtedChunks {
+  std::vector<std::vector<MeshData>> levels;
+  std::vector<std::vector<std::array<MeshData, 4>>> skirts;
+  std::vector<std::array<int, 4>> across;
 };
 
 }  // namespace downpour::render

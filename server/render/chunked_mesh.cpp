@@ -35,8 +35,23 @@ void append(MeshData& all, const MeshData& part) {
 ChunkedMesh::ChunkedMesh(const std::vector<std::vector<MeshData>>& chunks,
                          std::vector<float> level_distances_m, float max_distance_m)
     : level_distances_m_(std::move(level_distances_m)), max_distance_m_(max_distance_m) {
+  build(chunks, nullptr);
+}
+
+ChunkedMesh::ChunkedMesh(const SkirtedChunks& chunks, std::vector<float> level_distances_m,
+                         float max_distance_m)
+    : level_distances_m_(std::move(level_distances_m)), max_distance_m_(max_distance_m) {
+  if (chunks.skirts.size() != chunks.levels.size() ||
+      chunks.across.size() != chunks.levels.size()) {
+    throw std::logic_error("skirted chunks without a skirt and a neighbour list each");
+  }
+  build(chunks.levels, &chunks);
+}
+
+void ChunkedMesh::build(const std::vector<std::vector<MeshData>>& chunks,
+                        const SkirtedChunks* skirted) {
   // Level by level, each level's chunks in their order: neighbours drawn at one level are one
-  // range of indices, and draw_visible() joins them into one draw.
+  // range of indices, and draw_visible() joins them into one draw. The skirts follow, apart.
   std::size_t levels = 0;
   chunks_.resize(chunks.size());
   for (std::size_t c = 0; c < chunks.size(); ++c) {
@@ -46,28 +61,52 @@ ChunkedMesh::ChunkedMesh(const std::vector<std::vector<MeshData>>& chunks,
     chunks_[c].bounds_max = glm::vec3(-1e30f);
   }
   MeshData all;
+  auto put = [&all](const MeshData& part) {
+    const Range r{static_cast<std::uint32_t>(all.indices.size()),
+                  static_cast<std::uint32_t>(part.indices.size())};
+    append(all, part);
+    return r;
+  };
   for (std::size_t l = 0; l < levels; ++l) {
     for (std::size_t c = 0; c < chunks.size(); ++c) {
       if (l >= chunks[c].size()) continue;
       const MeshData& level = chunks[c][l];
       Chunk& chunk = chunks_[c];
-      chunk.levels[l] = {static_cast<std::uint32_t>(all.indices.size()),
-                         static_cast<std::uint32_t>(level.indices.size())};
-      append(all, level);
+      chunk.levels[l] = put(level);
       chunk.bounds_min = glm::min(chunk.bounds_min, level.bounds_min);
       chunk.bounds_max = glm::max(chunk.bounds_max, level.bounds_max);
     }
   }
+  if (skirted) {
+    for (std::size_t c = 0; c < chunks.size(); ++c) {
+      Chunk& chunk = chunks_[c];
+      chunk.across = skirted->across[c];
+      for (const std::array<MeshData, 4>& edges : skirted->skirts[c]) {
+        std::array<Range, 4>& ranges = chunk.skirts.emplace_back();
+        for (int e = 0; e < 4; ++e) {
+          ranges[e] = put(edges[e]);
+          chunk.bounds_min = glm::min(chunk.bounds_min, edges[e].bounds_min);
+          chunk.bounds_max = glm::max(chunk.bounds_max, edges[e].bounds_max);
+        }
+      }
+      if (chunk.skirts.size() != chunk.levels.size())
+        throw std::logic_error("a chunk's skirts and levels differ in number");
+    }
+  }
   if (!all.indices.empty()) mesh_ = Mesh(all);
+  level_drawn_.resize(chunks_.size());
   ranges_.reserve(chunks_.size());
   counts_.reserve(chunks_.size());
   offsets_.reserve(chunks_.size());
 }
 
 template <typename Fn>
-void ChunkedMesh::for_each_visible(const glm::mat4& view_proj, const glm::vec3& camera,
-                                   float distance_scale, float from_m, float to_m, Fn&& fn) const {
-  for (const Chunk& chunk : chunks_) {
+void ChunkedMesh::for_each_drawn(const glm::mat4& view_proj, const glm::vec3& camera,
+                                 float distance_scale, float from_m, float to_m, Fn&& fn) const {
+  // Each chunk's level, or -1 where it is not drawn.
+  for (std::size_t c = 0; c < chunks_.size(); ++c) {
+    const Chunk& chunk = chunks_[c];
+    level_drawn_[c] = -1;
     if (chunk.levels.empty() || !box_visible(view_proj, chunk.bounds_min, chunk.bounds_max))
       continue;
     const float nearest =
@@ -83,14 +122,25 @@ void ChunkedMesh::for_each_visible(const glm::mat4& view_proj, const glm::vec3& 
            distance >= level_distances_m_[level]) {
       ++level;
     }
+    level_drawn_[c] = static_cast<int>(level);
+  }
+  for (std::size_t c = 0; c < chunks_.size(); ++c) {
+    const int level = level_drawn_[c];
+    if (level < 0) continue;
+    const Chunk& chunk = chunks_[c];
     fn(chunk.levels[level]);
+    if (chunk.skirts.empty()) continue;
+    for (int e = 0; e < 4; ++e) {
+      const int n = chunk.across[e];
+      if (n >= 0 && level_drawn_[n] >= 0 && level_drawn_[n] != level) fn(chunk.skirts[level][e]);
+    }
   }
 }
 
 void ChunkedMesh::draw_visible(const glm::mat4& view_proj, const glm::vec3& camera,
                                float distance_scale, float from_m, float to_m) const {
   ranges_.clear();
-  for_each_visible(view_proj, camera, distance_scale, from_m, to_m, [this](const Range& r) {
+  for_each_drawn(view_proj, camera, distance_scale, from_m, to_m, [this](const Range& r) {
     if (r.count != 0) ranges_.push_back(r);
   });
   // Ranges that meet in the buffer become one.
@@ -115,8 +165,8 @@ void ChunkedMesh::draw_visible(const glm::mat4& view_proj, const glm::vec3& came
 std::size_t ChunkedMesh::visible_triangles(const glm::mat4& view_proj,
                                            const glm::vec3& camera) const {
   std::size_t triangles = 0;
-  for_each_visible(view_proj, camera, 1.0f, 0.0f, 1e30f,
-                   [&](const Range& r) { triangles += r.count / 3; });
+  for_each_drawn(view_proj, camera, 1.0f, 0.0f, 1e30f,
+                 [&](const Range& r) { triangles += r.count / 3; });
   return triangles;
 }
 

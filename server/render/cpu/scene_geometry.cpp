@@ -187,7 +187,7 @@ double terrain_height(const sim::RoadNetwork& roads, double x, double y) {
   return glm::mix(std::min(edge, natural), natural, blend);
 }
 
-std::vector<std::vector<MeshData>> build_terrain_chunks(const sim::RoadNetwork& roads) {
+SkirtedChunks build_terrain_chunks(const sim::RoadNetwork& roads) {
   // Bounds of the roads' reference lines plus a margin.
   glm::dvec2 lo(1e30), hi(-1e30);
   for (int road = 0; road < roads.road_count(); ++road) {
@@ -223,17 +223,17 @@ std::vector<std::vector<MeshData>> build_terrain_chunks(const sim::RoadNetwork& 
     out.push_back(last);
     return out;
   };
-  std::vector<std::vector<MeshData>> chunks;
+  SkirtedChunks chunks;
   for (int cj = 0; cj < kTerrainChunks; ++cj) {
     for (int ci = 0; ci < kTerrainChunks; ++ci) {
       const int i0 = nx * ci / kTerrainChunks, i1 = nx * (ci + 1) / kTerrainChunks;
       const int j0 = ny * cj / kTerrainChunks, j1 = ny * (cj + 1) / kTerrainChunks;
       std::vector<MeshData> levels;
+      std::vector<std::array<MeshData, 4>> skirts;
       for (int level = 0; level < kTerrainLevels; ++level) {
         const int step = 1 << level;
         const std::vector<int> is = samples(i0, i1, step), js = samples(j0, j1, step);
-        MeshData m;
-        auto vertex = [&](int i, int j, float drop) {
+        auto vertex = [&](MeshData& m, int i, int j, float drop) {
           const float x = static_cast<float>(lo.x + i * cell);
           const float y = static_cast<float>(lo.y + j * cell);
           const glm::vec3 n =
@@ -241,8 +241,9 @@ std::vector<std::vector<MeshData>> build_terrain_chunks(const sim::RoadNetwork& 
                                        2.0f * static_cast<float>(cell)));
           return m.add_vertex({x, y, h(i, j) - drop}, n, {x, y});
         };
+        MeshData m;
         for (int j : js) {
-          for (int i : is) vertex(i, j, 0.0f);
+          for (int i : is) vertex(m, i, j, 0.0f);
         }
         const auto cols = static_cast<std::uint32_t>(is.size());
         for (std::uint32_t r = 0; r + 1 < js.size(); ++r) {
@@ -251,16 +252,19 @@ std::vector<std::vector<MeshData>> build_terrain_chunks(const sim::RoadNetwork& 
             m.add_quad(a, a + 1, a + 1 + cols, a + cols);
           }
         }
+        levels.push_back(std::move(m));
         // Skirts hanging from the edges hide the cracks where a neighbour is drawn finer.
         const float drop = static_cast<float>(kSkirtDepthPerCell * step * cell + 2.0);
         auto skirt = [&](const std::vector<std::pair<int, int>>& edge) {
+          MeshData s;
           for (std::size_t k = 0; k + 1 < edge.size(); ++k) {
-            const std::uint32_t a = vertex(edge[k].first, edge[k].second, 0.0f);
-            const std::uint32_t b = vertex(edge[k + 1].first, edge[k + 1].second, 0.0f);
-            const std::uint32_t c = vertex(edge[k + 1].first, edge[k + 1].second, drop);
-            const std::uint32_t d = vertex(edge[k].first, edge[k].second, drop);
-            m.add_quad(a, b, c, d);
+            const std::uint32_t a = vertex(s, edge[k].first, edge[k].second, 0.0f);
+            const std::uint32_t b = vertex(s, edge[k + 1].first, edge[k + 1].second, 0.0f);
+            const std::uint32_t c = vertex(s, edge[k + 1].first, edge[k + 1].second, drop);
+            const std::uint32_t d = vertex(s, edge[k].first, edge[k].second, drop);
+            s.add_quad(a, b, c, d);
           }
+          return s;
         };
         std::vector<std::pair<int, int>> south, north, west, east;
         for (int i : is) {
@@ -271,10 +275,16 @@ std::vector<std::vector<MeshData>> build_terrain_chunks(const sim::RoadNetwork& 
           west.emplace_back(i0, j);
           east.emplace_back(i1, j);
         }
-        for (const auto* edge : {&south, &north, &west, &east}) skirt(*edge);
-        levels.push_back(std::move(m));
+        skirts.push_back({skirt(south), skirt(north), skirt(west), skirt(east)});
       }
-      chunks.push_back(std::move(levels));
+      chunks.levels.push_back(std::move(levels));
+      chunks.skirts.push_back(std::move(skirts));
+      auto at = [](int i, int j) {
+        return i < 0 || j < 0 || i >= kTerrainChunks || j >= kTerrainChunks
+                   ? -1
+                   : j * kTerrainChunks + i;
+      };
+      chunks.across.push_back({at(ci, cj - 1), at(ci, cj + 1), at(ci - 1, cj), at(ci + 1, cj)});
     }
   }
   return chunks;

@@ -22,7 +22,7 @@ std::vector<std::vector<MeshData>> build_road_chunks(const sim::RoadNetwork& roa
 // The ground meets the road a little below its edge. uv = world xy in metres. 16 x 16 chunks, each
 // at four levels of detail (cells of 20, 40, 80 and 160 m over the same grid) with skirts that hide
 // the cracks between neighbours drawn at different levels.
-std::vector<std::vector<MeshData>> build_terrain_chunks(const sim::RoadNetwork& roads);
+SkirtedChunks build_terrain_chunks(const sim::RoadNetwork& roads);
 
 // The street lights' meshes (street_light_pass.hpp), four poles a chunk (one level of detail).
 std::vector<std::vector<MeshData>> build_street_light_chunks(

@@ -14,7 +14,8 @@ namespace downpour::render {
 
 struct WorldGeometry {
   std::vector<sim::StreetLight> street_lights;  // sim/lights.hpp
-  std::vector<std::vector<MeshData>> road, terrain, poles;
+  std::vector<std::vector<MeshData>> road, poles;
+  SkirtedChunks terrain;
   double build_ms = 0.0;
 };
 WorldGeometry build_world_geometry(const sim::RoadNetwork& roads);

@@ -1,10 +1,14 @@
 // The road's meshes built from an OpenDRIVE network: lane sections whose lanes differ in number
 // give each its own mesh, whole and indexed within its vertices; a narrow one-sided road's relief
-// is made without a bowl out of its room.
+// is made without a bowl out of its room. The terrain's chunks meet without a crack where two are
+// drawn at one level, so that their skirts are needed only where the levels differ.
 #include "server/render/cpu/scene_geometry.hpp"
 
+#include <algorithm>
 #include <memory>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -77,6 +81,56 @@ TEST(SceneGeometryTest, LaneSectionsOfDifferentLanesMakeWholeMeshes) {
       ASSERT_GT(r, -0.05);
     }
   }
+}
+
+// The terrain chunk's vertices on edge `e` (south, north, west, east), sorted.
+std::vector<std::tuple<float, float, float>> edge_vertices(const MeshData& surface, int e) {
+  float line = 0.0f;
+  const int axis = e < 2 ? 1 : 0;  // south and north lie along y = const
+  const bool low = e % 2 == 0;
+  line = low ? surface.bounds_min[axis] : surface.bounds_max[axis];
+  std::vector<std::tuple<float, float, float>> out;
+  for (const MeshVertex& v : surface.vertices) {
+    if (v.position[axis] == line) out.emplace_back(v.position.x, v.position.y, v.position.z);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(SceneGeometryTest, TerrainChunksAtOneLevelShareTheirEdges) {
+  const auto roads = std::make_shared<const sim::OpenDriveRoads>(road::parse_opendrive(network()));
+  const SkirtedChunks terrain = build_terrain_chunks(*roads);
+  ASSERT_EQ(terrain.levels.size(), 256u);
+  ASSERT_EQ(terrain.skirts.size(), terrain.levels.size());
+  ASSERT_EQ(terrain.across.size(), terrain.levels.size());
+  int borders = 0, finer_edges = 0;
+  for (std::size_t c = 0; c < terrain.levels.size(); ++c) {
+    ASSERT_EQ(terrain.levels[c].size(), 4u);
+    ASSERT_EQ(terrain.skirts[c].size(), 4u);
+    for (int e = 0; e < 4; ++e) {
+      const int n = terrain.across[c][e];
+      if (n < 0) {
+        ++borders;
+        continue;
+      }
+      ASSERT_LT(n, static_cast<int>(terrain.levels.size()));
+      EXPECT_EQ(terrain.across[n][e ^ 1], static_cast<int>(c)) << "neighbours both ways";
+      for (int k = 0; k < 4; ++k) {
+        // The same vertices, bit for bit, on both sides of the edge: no crack at one level.
+        const auto mine = edge_vertices(terrain.levels[c][k], e);
+        ASSERT_GE(mine.size(), 2u);
+        EXPECT_EQ(mine, edge_vertices(terrain.levels[n][k], e ^ 1)) << c << " " << e << " " << k;
+        // The skirt hangs from those vertices.
+        const MeshData& skirt = terrain.skirts[c][k][e];
+        EXPECT_EQ(skirt.indices.size(), (mine.size() - 1) * 6);
+        EXPECT_LT(skirt.bounds_min.z, std::get<2>(mine.front()) - 1.0f);
+        if (k > 0) finer_edges += edge_vertices(terrain.levels[c][k - 1], e).size() > mine.size();
+      }
+    }
+  }
+  EXPECT_EQ(borders, 4 * 16) << "the border's chunks have no neighbour outside";
+  // A finer level's edge has vertices the coarser lacks, which is where a crack opens.
+  EXPECT_GT(finer_edges, 0);
 }
 
 }  // namespace
