@@ -45,6 +45,12 @@ ChunkedMesh::ChunkedMesh(const SkirtedChunks& chunks, std::vector<float> level_d
       chunks.across.size() != chunks.levels.size()) {
     throw std::logic_error("skirted chunks without a skirt and a neighbour list each");
   }
+  for (const std::array<int, 4>& across : chunks.across) {
+    for (const int n : across) {
+      if (n < -1 || n >= static_cast<int>(chunks.levels.size()))
+        throw std::logic_error("a chunk's neighbour is not one of the chunks");
+    }
+  }
   build(chunks.levels, &chunks);
 }
 
