@@ -24,7 +24,6 @@ void append(MeshData& all, const MeshData& part) {
   all.vertices.insert(all.vertices.end(), part.vertices.begin(), part.vertices.end());
   all.curvature.insert(all.curvature.end(), part.curvature.begin(), part.curvature.end());
   all.lanes.insert(all.lanes.end(), part.lanes.begin(), part.lanes.end());
-  all.indices.reserve(all.indices.size() + part.indices.size());
   for (const std::uint32_t i : part.indices) all.indices.push_back(base + i);
   all.bounds_min = glm::min(all.bounds_min, part.bounds_min);
   all.bounds_max = glm::max(all.bounds_max, part.bounds_max);
@@ -66,7 +65,24 @@ void ChunkedMesh::build(const std::vector<std::vector<MeshData>>& chunks,
     chunks_[c].bounds_min = glm::vec3(1e30f);
     chunks_[c].bounds_max = glm::vec3(-1e30f);
   }
+  // Every part's room made at once (reserving each part's as it came copied all the buffer each
+  // time: the terrain's 5,120 parts took seconds under ASan).
   MeshData all;
+  std::size_t vertices = 0, indices = 0;
+  auto count = [&](const MeshData& part) {
+    vertices += part.vertices.size();
+    indices += part.indices.size();
+  };
+  for (const std::vector<MeshData>& chunk : chunks)
+    std::for_each(chunk.begin(), chunk.end(), count);
+  if (skirted) {
+    for (const auto& levels : skirted->skirts) {
+      for (const std::array<MeshData, 4>& edges : levels)
+        std::for_each(edges.begin(), edges.end(), count);
+    }
+  }
+  all.vertices.reserve(vertices);
+  all.indices.reserve(indices);
   auto put = [&all](const MeshData& part) {
     const Range r{static_cast<std::uint32_t>(all.indices.size()),
                   static_cast<std::uint32_t>(part.indices.size())};
