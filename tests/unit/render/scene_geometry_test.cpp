@@ -85,10 +85,8 @@ TEST(SceneGeometryTest, LaneSectionsOfDifferentLanesMakeWholeMeshes) {
 
 // The terrain chunk's vertices on edge `e` (south, north, west, east), sorted.
 std::vector<std::tuple<float, float, float>> edge_vertices(const MeshData& surface, int e) {
-  float line = 0.0f;
   const int axis = e < 2 ? 1 : 0;  // south and north lie along y = const
-  const bool low = e % 2 == 0;
-  line = low ? surface.bounds_min[axis] : surface.bounds_max[axis];
+  const float line = e % 2 == 0 ? surface.bounds_min[axis] : surface.bounds_max[axis];
   std::vector<std::tuple<float, float, float>> out;
   for (const MeshVertex& v : surface.vertices) {
     if (v.position[axis] == line) out.emplace_back(v.position.x, v.position.y, v.position.z);
@@ -120,10 +118,27 @@ TEST(SceneGeometryTest, TerrainChunksAtOneLevelShareTheirEdges) {
         const auto mine = edge_vertices(terrain.levels[c][k], e);
         ASSERT_GE(mine.size(), 2u);
         EXPECT_EQ(mine, edge_vertices(terrain.levels[n][k], e ^ 1)) << c << " " << e << " " << k;
-        // The skirt hangs from those vertices.
+        // The skirt hangs from those vertices: its upper vertices are they, its lower ones lie
+        // below them.
         const MeshData& skirt = terrain.skirts[c][k][e];
         EXPECT_EQ(skirt.indices.size(), (mine.size() - 1) * 6);
-        EXPECT_LT(skirt.bounds_min.z, std::get<2>(mine.front()) - 1.0f);
+        std::vector<std::tuple<float, float, float>> upper;
+        int below = 0;
+        for (const MeshVertex& v : skirt.vertices) {
+          const std::tuple<float, float, float> p(v.position.x, v.position.y, v.position.z);
+          if (std::binary_search(mine.begin(), mine.end(), p)) {
+            upper.push_back(p);
+          } else {
+            below += std::any_of(mine.begin(), mine.end(), [&](const auto& m) {
+              return std::get<0>(m) == v.position.x && std::get<1>(m) == v.position.y &&
+                     std::get<2>(m) > v.position.z + 1.0f;
+            });
+          }
+        }
+        std::sort(upper.begin(), upper.end());
+        upper.erase(std::unique(upper.begin(), upper.end()), upper.end());
+        EXPECT_EQ(upper, mine) << c << " " << e << " " << k;
+        EXPECT_EQ(below * 2, static_cast<int>(skirt.vertices.size()));
         if (k > 0) finer_edges += edge_vertices(terrain.levels[c][k - 1], e).size() > mine.size();
       }
     }
