@@ -96,27 +96,30 @@ vec2 lane_mark(float mark, float u, float w, float dash) {
 // under it (whose cells there hold the finer ones' means), the last one to the rings' mean; without
 // rings, the weather's wetness alone. A ring's fading band lies well inside the next ring (twice
 // its size), so a point takes at most two rings: the finest that holds it and the next. Both are
-// found by a loop over every ring the same for all pixels, then fetched once each: llvmpipe runs a
-// loop that ends pixel by pixel, masked, until its last pixel is done (2 ms of ROAD's road pass).
+// found from the point's distance to the rings' middle, then fetched once each: llvmpipe runs a
+// loop that ends pixel by pixel, masked, until its last pixel is done (2 ms of ROAD's road pass),
+// and a loop over every ring, the same for all pixels, cost 0.9 ms.
 vec2 water_at(vec2 xy) {
   float wet = frame.wetness;
   if (frame.road_water_state.w == 0.0) return vec2(wet * 0.5, wet * wet * 0.15);
   int rings = int(frame.road_water.x);
-  float none = float(rings);  // beyond the last ring: the mean
-  float layer = none, next_layer = none, inside = 0.0;
-  vec2 uv = vec2(0.0), next_uv = vec2(0.0);
-  for (int l = 3; l >= 0; --l) {  // coarse to fine: the finest that holds xy is kept last
-    vec4 ring = frame.road_water_rings[l];
-    vec2 u = (xy - ring.xy) * ring.z;
-    vec2 edge = min(u, 1.0 - u);  // in the ring's sides; its band is 4 of its cells
-    float in_l = clamp(min(edge.x, edge.y) * frame.road_water.y, 0.0, 1.0);
-    bool holds = l < rings && in_l > 0.0;
-    next_layer = holds ? layer : next_layer;
-    next_uv = holds ? uv : next_uv;
-    layer = holds ? float(l) : layer;
-    uv = holds ? u : uv;
-    inside = holds ? in_l : inside;
-  }
+  // The finest ring that may hold xy, by its distance from ring 0's middle (along x or y), and
+  // the next: where xy lies outside the first, it lies past the second's fading band (windows of
+  // 64 cells or more, RoadWaterConfig).
+  vec4 r0 = frame.road_water_rings[0];
+  vec2 off = abs(xy - r0.xy - 0.5 / r0.z);
+  float l = dot(step(frame.road_water_reach, vec4(max(off.x, off.y))), vec4(1.0));
+  int li = min(int(l), 3);
+  // (Chosen, not indexed: llvmpipe would gather an indexed uniform lane by lane.)
+  vec4 r1 = frame.road_water_rings[1], r2 = frame.road_water_rings[2], r3 = frame.road_water_rings[3];
+  vec4 ring = li == 0 ? r0 : li == 1 ? r1 : li == 2 ? r2 : r3;
+  vec4 next = li == 0 ? r1 : li == 1 ? r2 : r3;
+  vec2 uv = (xy - ring.xy) * ring.z;
+  vec2 next_uv = (xy - next.xy) * next.z;
+  vec2 edge = min(uv, 1.0 - uv);
+  float inside = clamp(min(edge.x, edge.y) * frame.road_water.y, 0.0, 1.0);
+  float none = float(rings);
+  float layer = l < none ? l : none, next_layer = l + 1.0 < none ? l + 1.0 : none;
   vec2 mean = frame.road_water_state.yz;
   vec2 fine = layer < none ? texture(road_water_tex, vec3(uv, layer)).rg : mean;
   vec2 coarse = next_layer < none ? texture(road_water_tex, vec3(next_uv, next_layer)).rg : mean;

@@ -55,6 +55,7 @@ WaterBlock water_block(const FrameContext& f, const Mirror& mirror, bool reflect
           glm::vec4(static_cast<float>(image->origins[l].x * cell),
                     static_cast<float>(image->origins[l].y * cell),
                     static_cast<float>(1.0 / (image->cells * cell)), static_cast<float>(cell));
+      w.road_water_reach[l] = static_cast<float>(image->reach_m(l));
     }
     w.road_water_state = glm::vec4(static_cast<float>(image->capacity_mm), image->mean_water_mm,
                                    image->mean_standing_mm, 1.0f);
@@ -86,6 +87,7 @@ FrameBlock make_block(const FrameContext& f, const WaterBlock& water, const Lamp
   b.clip_plane = water.clip_plane;
   b.road_water = water.road_water;
   b.road_water_rings = water.road_water_rings;
+  b.road_water_reach = water.road_water_reach;
   b.road_water_state = water.road_water_state;
   b.lamp_map = lamps.params;
   b.lamp_rings = lamps.rings;

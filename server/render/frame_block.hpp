@@ -3,6 +3,7 @@
 // fields. And that mirror: the road's plane under the car.
 #pragma once
 
+#include <limits>
 #include <memory>
 
 #include <glm/mat4x4.hpp>
@@ -36,6 +37,7 @@ struct WaterBlock {
   glm::vec4 clip_plane{0.0f, 0.0f, 0.0f, 1.0f};
   glm::vec4 road_water{0.0f};
   glm::mat4 road_water_rings{0.0f};
+  glm::vec4 road_water_reach{std::numeric_limits<float>::max()};
   glm::vec4 road_water_state{0.5f, 0.0f, 0.0f, 0.0f};
 };
 // `reflection`: whether the view's road reads the road reflection this frame.

@@ -28,6 +28,12 @@ RoadState road_state(double water_m, const RoadWaterConfig& config) {
                                       : RoadState::kPuddle;
 }
 
+double RoadWaterImage::reach_m(int level) const {
+  auto middle = [&](int l) { return (glm::dvec2(origins[l]) + 0.5 * cells) * level_cell_m(l); };
+  const glm::dvec2 off = glm::abs(middle(level) - middle(0));
+  return 0.5 * cells * level_cell_m(level) + std::max(off.x, off.y);
+}
+
 glm::vec2 RoadWaterImage::at(glm::dvec2 xy) const {
   for (int l = 0; l < levels; ++l) {
     const glm::ivec2 cell = glm::ivec2(glm::floor(xy / level_cell_m(l))) - origins[l];
@@ -41,7 +47,7 @@ glm::vec2 RoadWaterImage::at(glm::dvec2 xy) const {
 RoadWater::RoadWater(const RoadSurface& surface, RoadWaterConfig config)
     : surface_(surface),
       config_(config),
-      n_(std::max(48, config.cells / 8 * 8)),
+      n_(std::max(64, config.cells / 8 * 8)),
       levels_(std::clamp(config.levels, 1, kRoadWaterMaxLevels)) {
   const std::size_t count = static_cast<std::size_t>(levels_) * n_ * n_;
   ground_.assign(count, 0.0);

@@ -57,6 +57,11 @@ struct RoadWaterImage {
            water_standing_mm.size() >= static_cast<std::size_t>(levels) * cells * cells * 2;
   }
   double level_cell_m(int level) const { return cell_m * static_cast<double>(1 << level); }
+  // How far from the middle of the finest window (m, along x or y) `level`'s window reaches: its
+  // half side, plus how far its middle lies from the finest's. No point that far out or further
+  // lies in it. (The renderer finds a point's rings by it, without a loop over them:
+  // road_surface.glsl's water_at.)
+  double reach_m(int level) const;
   // Water and standing water (mm) at a world position: the finest level that holds it, else the
   // means. Requires complete().
   glm::vec2 at(glm::dvec2 xy) const;
@@ -66,8 +71,10 @@ struct RoadWaterConfig {
   // S0: a drop's wet spot is a centimetre or two; cells that small around a car would be millions,
   // so the finest cell is a quarter of a metre, finer than a rut (0.7 m wide) or a bowl.
   double cell_m = 0.25;
-  // Every level's window side in cells (a multiple of 8, 48 or more): 16 m of 0.25 m cells, then
-  // 32, 64 and 128 m of 0.5, 1 and 2 m cells.
+  // Every level's window side in cells (a multiple of 8, 64 or more): 16 m of 0.25 m cells, then
+  // 32, 64 and 128 m of 0.5, 1 and 2 m cells. (From 64 a point that the finest window that may
+  // hold it does not hold lies past the next one's fading band, which the renderer's lookup of the
+  // rings takes for granted: RoadWaterImage::reach_m.)
   int cells = 64;
   int levels = 4;  // 1 to kRoadWaterMaxLevels
   // What the asphalt's texture holds before water stands on it (macrotexture depth of a dense

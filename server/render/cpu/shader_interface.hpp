@@ -95,6 +95,9 @@ namespace downpour::render {
   X(mat4, road_water_rings,                                                                   \
     "column l: ring l's window, xy its lower-left corner (world m), z 1 / its side (m), "     \
     "w its cell (m)")                                                                         \
+  X(vec4, road_water_reach,                                                                   \
+    "[l]: ring l's reach from ring 0's middle along x or y (m, "                              \
+    "RoadWaterImage::reach_m); past the rings, the largest float")                            \
   X(vec4, road_water_state,                                                                   \
     "x capacity (mm), y z the window's mean water and standing water "                        \
     "(mm), w 1 with the window, else 0 (the wetness alone)")                                  \

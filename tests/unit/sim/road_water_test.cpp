@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <initializer_list>
 #include <set>
@@ -471,6 +472,58 @@ TEST_F(RoadWaterTest, TheImageForTheRendererIsTheRingsInMillimetres) {
         << ahead << " m ahead";
   }
   EXPECT_EQ(image.at(at(450.0, -1.75)).x, image.mean_water_mm);  // past the last ring
+}
+
+// The renderer finds a point's two rings from its distance to the finest window's middle
+// (RoadWaterImage::reach_m, road_surface.glsl's water_at): the finest window whose reach the point
+// lies within, and the next. That holds wherever the car is: every window nearer than the first
+// holds no point of it, and where the first does not hold it, the next holds it past its fading
+// band (4 cells), as a lookup that tries every ring would find.
+TEST(RoadWaterImageTest, TheFinestRingThatMayHoldAPointAndTheNextAreAllItNeeds) {
+  const RoadWaterConfig config;
+  RoadWaterImage image;
+  image.cell_m = config.cell_m;
+  image.cells = config.cells;
+  image.levels = config.levels;
+  std::uint32_t seed = 12345u;
+  auto uniform = [&](double lo, double hi) {
+    seed = seed * 1664525u + 1013904223u;
+    return lo + (hi - lo) * static_cast<double>(seed >> 8) / static_cast<double>(1u << 24);
+  };
+  // How far inside window l a point lies, in its cells (negative outside).
+  auto inside_cells = [&](int l, glm::dvec2 p) {
+    const double cell = image.level_cell_m(l);
+    const glm::dvec2 u = p / cell - glm::dvec2(image.origins[l]);
+    return std::min({u.x, u.y, image.cells - u.x, image.cells - u.y});
+  };
+  int first_holds = 0, next_holds = 0, past_all = 0;
+  for (int car = 0; car < 400; ++car) {
+    const glm::dvec2 centre(uniform(-5000.0, 5000.0), uniform(-5000.0, 5000.0));
+    image.origins = RoadWater::ring_origins(centre, image.cell_m, image.cells, image.levels);
+    const glm::dvec2 middle0 = (glm::dvec2(image.origins[0]) + 0.5 * image.cells) * image.cell_m;
+    for (int k = 0; k < 200; ++k) {
+      const glm::dvec2 p = centre + glm::dvec2(uniform(-150.0, 150.0), uniform(-150.0, 150.0));
+      const glm::dvec2 off(std::abs(p.x - middle0.x), std::abs(p.y - middle0.y));
+      int first = 0;
+      while (first < image.levels && std::max(off.x, off.y) >= image.reach_m(first)) ++first;
+      for (int l = 0; l < first; ++l)
+        ASSERT_LE(inside_cells(l, p), 0.0) << "window " << l << " holds a point past its reach";
+      if (first == image.levels) {
+        ++past_all;
+        continue;
+      }
+      if (inside_cells(first, p) > 0.0) {
+        ++first_holds;
+      } else if (first + 1 < image.levels) {
+        ASSERT_GE(inside_cells(first + 1, p), 4.0) << "in window " << first + 1 << "'s band";
+        ++next_holds;
+      }
+    }
+  }
+  // (Each case met many times.)
+  EXPECT_GT(first_holds, 1000);
+  EXPECT_GT(next_holds, 300);
+  EXPECT_GT(past_all, 1000);
 }
 
 }  // namespace
