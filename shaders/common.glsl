@@ -22,6 +22,27 @@ vec3 sky_gradient(vec3 dir) {
   return sky;
 }
 
+// Value noise on a lattice of unit cells: a hash's value in [0, 1] at each corner, quintic
+// between them, as noise_tex's channels hold it, but computed: on llvmpipe a filtered fetch over
+// a view's road or sky costs some 0.2-0.5 ms, these few integer operations next to nothing.
+float value_noise(vec2 p) {
+  vec2 i = floor(p), f = p - i;
+  vec2 u = f * f * f * (f * (f * 6.0 - 15.0) + 10.0);
+  // The corners' hash: the lattice point's coordinates mixed (multiply, xor-shift, multiply).
+  uvec2 c = uvec2(ivec2(i)) * uvec2(0x8da6b343u, 0xd8163841u);
+  uvec2 d = c + uvec2(0x8da6b343u, 0xd8163841u);
+  uvec4 h = uvec4(c.x, d.x, c.x, d.x) + uvec4(c.y, c.y, d.y, d.y);
+  h = (h ^ (h >> 16u)) * 0x7feb352du;
+  h = (h ^ (h >> 15u)) * 0x846ca68bu;
+  vec4 v = vec4(h >> 8u) * (1.0 / 16777215.0);
+  return mix(mix(v.x, v.y, u.x), mix(v.z, v.w, u.x), u.y);
+}
+// The same where a pixel spans `cells` of its cells (length(fwidth(p))): toward its mean, 0.5, as
+// that goes from half a cell to two, as mipmaps would average it away.
+float value_noise_filtered(vec2 p, float cells) {
+  return mix(0.5, value_noise(p), clamp((2.0 - cells) * (1.0 / 1.5), 0.0, 1.0));
+}
+
 // Haze, per vertex (mesh.vert): rgb the light scattered in along the way, a the transmittance.
 vec4 fog_at(vec3 world_pos) {
   vec3 to = world_pos - frame.camera_pos.xyz;

@@ -265,7 +265,7 @@ void main() {
 
   // Asphalt: light aggregate in dark binder; worn, darker wheel paths; patches.
   float h = relief.a;
-  float patches = texture(noise_tex, vec2(lat, s) / 40.0).g;
+  float patches = value_noise_filtered(vec2(lat, s) / 5.0, px / 5.0);  // 5 m cells
   vec3 albedo = vec3(mix(0.055, 0.16, smoothstep(0.15, 0.8, h))) * (0.85 + 0.3 * patches);
   float wheel_paths = stripe(lane_pos, 0.27, 0.09) + stripe(lane_pos, 0.73, 0.09);
   albedo *= 1.0 - 0.18 * clamp(wheel_paths, 0.0, 1.0) * driving;

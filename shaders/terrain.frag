@@ -8,10 +8,9 @@ out vec4 out_colour;
 void main() {
   vec3 n = normalize(v_normal);
   // Grass with patches of drier grass and soil, rock on steep slopes.
-  vec4 coarse = texture(noise_tex, v_uv / 600.0);
-  float large = coarse.r;
-  float medium = coarse.a;  // the 32-cell channel repeats every ~19 m
-  float fine = texture(noise_tex, v_uv / 6.0).a;
+  float large = value_noise(v_uv / 150.0);
+  float medium = value_noise_filtered(v_uv / 18.75, length(fwidth(v_uv)) / 18.75);
+  float fine = texture(noise_tex, v_uv / 6.0).a;  // 19 cm cells, their mipmaps further off
   vec3 grass = mix(vec3(0.09, 0.15, 0.05), vec3(0.20, 0.22, 0.09), large);
   grass = mix(grass, vec3(0.17, 0.14, 0.09), smoothstep(0.55, 0.8, medium) * 0.6);
   grass *= 0.8 + 0.4 * fine;
