@@ -16,6 +16,11 @@
                       Numpad0: "off", Numpad1: "intermittent", Numpad2: "low", Numpad3: "high", Numpad4: "single"};
   const keys = {throttle: false, brake: false, left: false, right: false};
   let targetFps = 20, sessionId = "", state = "idle", loops = [], pendingWeather = null, pendingWipers = null;
+  // Drives begun on this page: a status asked for before the latest one was driving tells nothing
+  // of it (on a loaded machine, a status asked for while the session was being made came back
+  // after the start's answer, said "no session", and stopped the page's controls: the viewer then
+  // closed the drive for want of them).
+  let drives = 0;
   const plots = new D.Plots($("plots"), $("plots-note"));
 
   function banner(text, info) {
@@ -104,7 +109,7 @@
       // (A session may take a while to create on a loaded server.)
       const d = await D.postJSON("/api/drive/start", {width: 480, height: 270, fps: 20}, 30000);
       if (d.state !== "driving") throw new Error(d.error || "the session was not created");
-      sessionId = d.session_id; state = "driving";
+      sessionId = d.session_id; state = "driving"; ++drives;
       setSliders(d.weather);
       showDrive(d);
       banner("");
@@ -133,10 +138,11 @@
 
   async function poll() {
     try {
+      const asked = drives;
       const s = await D.getJSON("/status.json");
       D.serverPill($("server"), s.server);
       const d = s.drive || {};
-      if (state === "driving") {
+      if (state === "driving" && asked === drives) {
         if (d.state === "ended" || (d.session_id && d.session_id !== sessionId) || !d.session_id) {
           state = "stopped";
           $("start").hidden = false; $("stop").hidden = true;
