@@ -108,7 +108,7 @@ struct FrameResources {
 
 // Resources made once and shared by the passes.
 struct SharedResources {
-  Texture noise;  // make_noise, repeat
+  Texture noise;  // make_noise, repeat (the terrain's grain)
   // The asphalt's relief and the setts', two layers over one tile (shared_resources.cpp), repeat,
   // mipmapped.
   Texture ground_relief;

@@ -23,7 +23,10 @@ std::vector<float> setts_height_unit(int size, std::uint32_t seed);
 // Heights in [0, 1] in alpha, their normals (relief_depth texels per unit height) in rgb.
 Image8 relief_image(const std::vector<float>& height, int size, float relief_depth);
 
-// Tileable value noise with a different frequency in each channel (4, 8, 16, 32 cells).
+// Tileable value noise with a different frequency in each channel (4, 8, 16, 32 cells). Only the
+// terrain's grain (alpha) is still fetched: the shaders compute their coarser noise
+// (common.glsl's value_noise). The other channels stay, drawn first from the same generator, so
+// that the grain keeps its pattern.
 Image8 make_noise(int size, std::uint32_t seed);
 
 }  // namespace downpour::render
