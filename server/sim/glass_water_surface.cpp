@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "server/sim/drop_physics.hpp"
 
 namespace downpour::sim {
@@ -82,7 +86,8 @@ void GlassWaterSurface::index(const GlassConfig& glass) {
   std::vector<std::uint32_t>& fill = tls_fill;
   std::vector<std::uint8_t>& wet = tls_wet;
   std::size_t n_pairs = 0;
-  wet.assign(n_cells, 0);
+  // (Two bytes past the last cell: the small bodies' rows below are written three cells wide.)
+  wet.assign(n_cells + 2, 0);
   std::uint8_t* const wet_cells_of = wet.data();
   for (std::size_t k = 0; k < bodies.size(); ++k) {
     const WaterBody b = bodies[k];  // (a copy: the byte stores below may alias a reference)
@@ -97,12 +102,54 @@ void GlassWaterSurface::index(const GlassConfig& glass) {
     const int j0 = std::max(0, static_cast<int>(std::floor((cv - ev) / cell)));
     const int j1 = std::min(cells_v - 1, static_cast<int>(std::floor((cv + ev) / cell)));
     if (i1 < i0 || j1 < j0) continue;
-    const std::size_t listed = static_cast<std::size_t>(i1 - i0 + 1) * (j1 - j0 + 1);
+    constexpr int kSmall = 3;  // cells a side that nearly every body's box spans at most
+    const std::size_t listed = std::max(static_cast<std::size_t>(i1 - i0 + 1) * (j1 - j0 + 1),
+                                        static_cast<std::size_t>(kSmall * kSmall));
     if (pairs.size() < n_pairs + listed)
       pairs.resize(std::max(2 * pairs.size(), n_pairs + listed + 4096));
     std::uint64_t* const out = pairs.data();
     const float half = b.half_length_mm, inv_side = 1.0f / b.side_mm;
     const float inv_front = 1.0f / b.front_mm, inv_back = 1.0f / b.back_mm;
+#if defined(__SSE2__)
+    if (i1 - i0 < kSmall && j1 - j0 < kSmall) {
+      // A small body (98% of them): its cells three rows of three, with no branch that depends on
+      // the body. A loop whose length changes from body to body, and the wet test's branch on
+      // front or back, went the wrong way about twice a body and took half the time. Each row's
+      // three cells are one vector; cells past the box are neither listed nor marked wet. The
+      // sums are the scalar loop's below, in the same order, so the same cells come out wet.
+      const __m128 lane = _mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f);
+      const __m128 du = _mm_sub_ps(
+          _mm_mul_ps(
+              _mm_add_ps(_mm_add_ps(_mm_set1_ps(static_cast<float>(i0)), lane), _mm_set1_ps(0.5f)),
+              _mm_set1_ps(cell)),
+          _mm_set1_ps(b.u_mm));
+      const __m128 du_axis_u = _mm_mul_ps(du, _mm_set1_ps(b.axis_u));
+      const __m128 du_axis_v = _mm_mul_ps(du, _mm_set1_ps(b.axis_v));
+      const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+      const __m128 lo = _mm_set1_ps(-half), hi = _mm_set1_ps(half);
+      const int in_row = (1 << (i1 - i0 + 1)) - 1;  // the lanes within the box
+      for (int dj = 0; dj < kSmall; ++dj) {
+        const int j = std::min(j0 + dj, j1);
+        const float dv = (static_cast<float>(j) + 0.5f) * cell - b.v_mm;
+        const __m128 a = _mm_add_ps(du_axis_u, _mm_set1_ps(dv * b.axis_v));
+        const __m128 y = _mm_sub_ps(_mm_set1_ps(dv * b.axis_u), du_axis_v);
+        const __m128 x = _mm_sub_ps(a, _mm_min_ps(_mm_max_ps(a, lo), hi));
+        const __m128 qx = _mm_add_ps(_mm_mul_ps(_mm_max_ps(x, zero), _mm_set1_ps(inv_front)),
+                                     _mm_mul_ps(_mm_min_ps(x, zero), _mm_set1_ps(inv_back)));
+        const __m128 qy = _mm_mul_ps(y, _mm_set1_ps(inv_side));
+        const __m128 r2 = _mm_add_ps(_mm_mul_ps(qx, qx), _mm_mul_ps(qy, qy));
+        const int row = j0 + dj <= j1 ? in_row : 0;
+        const int wet_lanes = _mm_movemask_ps(_mm_cmplt_ps(r2, one)) & row;
+        const int c = j * cells_u + i0;
+        for (int di = 0; di < kSmall; ++di) {
+          out[n_pairs] = static_cast<std::uint64_t>(c + std::min(di, i1 - i0)) << 32 | k;
+          n_pairs += (row >> di) & 1;
+          wet_cells_of[c + di] |= static_cast<std::uint8_t>((wet_lanes >> di) & 1);
+        }
+      }
+      continue;
+    }
+#endif
     for (int j = j0; j <= j1; ++j) {
       const float dv = (static_cast<float>(j) + 0.5f) * cell - b.v_mm;
       for (int i = i0; i <= i1; ++i) {

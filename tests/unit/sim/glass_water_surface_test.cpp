@@ -6,6 +6,9 @@
 #include "server/sim/glass_water_surface.hpp"
 
 #include <cmath>
+#include <set>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
@@ -112,6 +115,73 @@ TEST(GlassWaterSurfaceTest, EveryPointOfABodyIsListedInItsCell) {
   small.bodies.push_back(cap_body({60.0f * c, 60.0f * c}, 1.0f, 40.0));
   small.index(glass);
   EXPECT_EQ(small.entries.size(), 5u);
+}
+
+TEST(GlassWaterSurfaceTest, TheWetCellsAreThoseWhoseCentreLiesUnderWater) {
+  // Bodies of every kind, most a few cells wide (index()'s path for small bodies), some wider (its
+  // general path), one in ten at the grid's edges and corners; none with a cell's centre within a
+  // hair of its outline or of the glass's, so that rounding cannot decide. The wet cells are
+  // counted from the centres within the glass's outline.
+  const GlassConfig glass;
+  const double cell = GlassWaterSurface::kCellMm;
+  const auto c = [&](double i) { return static_cast<float>((i + 0.5) * cell); };
+  GlassWaterSurface one;  // wets one cell: how many cells the glass has
+  one.bodies.push_back(cap_body({c(100), c(50)}, 1.0f, 40.0));
+  one.index(glass);
+  ASSERT_GT(one.wet_fraction, 0.0);
+  const double glass_cells = 1.0 / one.wet_fraction;
+  // How far inside the glass's outline a point lies (< 0: outside).
+  const auto inside = [&](double u, double v) {
+    const double inset = glass.inset_mm(v);
+    return std::min({glass.height_mm - v, u - inset, glass.bottom_width_mm - inset - u});
+  };
+  RandomStream random(5, 0);
+  GlassWaterSurface surface;
+  std::set<std::pair<int, int>> wet;
+  while (surface.bodies.size() < 3000) {
+    const int kind = static_cast<int>(surface.bodies.size() % 5);
+    glm::dvec2 at(random.uniform(20.0, 1500.0), random.uniform(20.0, 740.0));
+    if (surface.bodies.size() % 10 == 0) {  // within 8 mm of an edge of the grid
+      const double grid_w = 1520.0, grid_h = 191 * cell;
+      at = random.uniform() < 0.5
+               ? glm::dvec2(random.uniform(0.0, grid_w), random.uniform() < 0.5
+                                                             ? random.uniform(-2.0, 8.0)
+                                                             : grid_h - random.uniform(-2.0, 8.0))
+               : glm::dvec2(random.uniform() < 0.5 ? random.uniform(-2.0, 8.0)
+                                                   : grid_w - random.uniform(-2.0, 8.0),
+                            random.uniform(0.0, grid_h));
+    }
+    const glm::vec2 centre(at);
+    const float r =
+        static_cast<float>(kind == 4 ? random.uniform(3.0, 9.0) : random.uniform(0.3, 2.6));
+    const glm::vec2 axis =
+        glm::normalize(glm::vec2(static_cast<float>(random.uniform(-1.0, 1.0)), -1.0f));
+    WaterBody b = kind == 3 ? cylinder_body(centre, axis, 0.6f * r, 0.5f * r, 40.0)
+                            : cap_body(centre, r, 40.0);
+    if (kind == 1 || kind == 2) {  // a tear, or a drop running along its heading with a tail
+      b.axis_u = axis.x, b.axis_v = axis.y;
+      b.front_mm *= kind == 1 ? 1.2f : 1.0f;
+      b.back_mm *= kind == 1 ? 0.85f : 1.6f;
+      b.side_mm *= kind == 1 ? 1.0f : 0.85f;
+    }
+    std::vector<std::pair<int, int>> centres;
+    bool clear = true;
+    const int reach = static_cast<int>(body_reach_mm(b) / cell) + 2;
+    const int i0 = static_cast<int>(b.u_mm / cell), j0 = static_cast<int>(b.v_mm / cell);
+    for (int j = std::max(j0 - reach, 0); j <= j0 + reach; ++j) {
+      for (int i = std::max(i0 - reach, 0); i <= i0 + reach; ++i) {
+        const double q = rho2(b, {c(i), c(j)}), in_glass = inside(c(i), c(j));
+        if (std::abs(q - 1.0) < 1e-3 || (q < 1.0 && std::abs(in_glass) < 1e-3)) clear = false;
+        if (q < 1.0 && in_glass > 0.0) centres.emplace_back(i, j);
+      }
+    }
+    if (!clear) continue;
+    surface.bodies.push_back(b);
+    wet.insert(centres.begin(), centres.end());
+  }
+  surface.index(glass);
+  EXPECT_GT(wet.size(), 3000u);
+  EXPECT_EQ(std::lround(surface.wet_fraction * glass_cells), static_cast<long>(wet.size()));
 }
 
 TEST(GlassWaterSurfaceTest, WhereTheWaterIsAndHowMuchOfTheGlassItWets) {
