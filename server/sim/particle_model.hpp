@@ -40,12 +40,13 @@ class ParticleModel {
   std::vector<Particle> particles_;
   double particle_mass_ = 0.0;
   // Scratch for repel: cells and keys in particle order, ids sorted by key, and the sorted
-  // particles' keys and float positions.
+  // particles' keys, float positions (padded to a whole group of four) and candidates.
   std::vector<glm::ivec2> sort_cell_;
   std::vector<std::uint64_t> sort_key_;
   std::vector<std::uint32_t> sort_ids_, sort_scratch_, sort_counts_;
   std::vector<std::uint64_t> sorted_key_;
-  std::vector<glm::vec2> sorted_pos_;
+  std::vector<float> sorted_x_, sorted_y_;
+  std::vector<std::array<std::uint32_t, 3>> ranges_;  // row end, below, below end
 };
 
 }  // namespace downpour::sim

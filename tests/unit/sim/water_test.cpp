@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
 
+#include "server/sim/particle_model.hpp"
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"
 #include "server/sim/wipers.hpp"
@@ -180,6 +181,27 @@ TEST(WaterTest, ParticlesDoNotOverlapAfterAStep) {
     }
   }
   EXPECT_GE(closest, 2.0 * r * 0.95) << "overlap left after the step (5% tolerance)";
+}
+
+TEST(WaterTest, AParticlePressedByManyPartsWithoutOvershooting) {
+  // One particle with six others each overlapping it by half a diameter, fanned out over its
+  // upper right: it gives way by about an overlap, not by the six overlaps summed.
+  WaterConfig config;
+  ParticleModel model(config);
+  const double touch = 2.0 * config.particle_radius_mm;
+  const glm::dvec2 pressed(100.0 + 0.1 * touch, 100.0 + 0.1 * touch);
+  model.add(pressed, 1.0);
+  for (int k = 0; k < 6; ++k) {
+    const double a = k * 15.0 * M_PI / 180.0;
+    model.add(pressed + 0.5 * touch * glm::dvec2(std::cos(a), std::sin(a)), 1.0);
+  }
+  model.repel();
+  const std::vector<ParticleModel::Particle>& p = model.particles();
+  const double moved = glm::length(p[0].pos - pressed);
+  EXPECT_GT(moved, 0.2 * touch);
+  EXPECT_LT(moved, 0.8 * touch) << "summed, its moves would carry it twice as far";
+  for (std::size_t k = 1; k < p.size(); ++k)
+    EXPECT_GT(glm::length(p[k].pos - p[0].pos), 0.75 * touch) << k;
 }
 
 TEST(WaterTest, SuspensionHoldsParticlesNearALargeDropAndReleasesThemAfter) {
