@@ -68,7 +68,10 @@ struct RainFieldConfig {
   double length_m = 24.0;        // along the car's heading
   double width_m = 12.0;
   double height_m = 5.5;       // above the ground under the car
-  double step_s = 1.0 / 60.0;  // the field's own fixed step
+  // The field's own fixed step. A drop falls straight between steps, so a longer step moves it
+  // the same; the renderer carries the drops on to a frame's time. (1/60 s cost the step thread
+  // 0.3 ms a frame more: 33,000 drops at 25 mm/h, twice a frame.)
+  double step_s = 1.0 / 30.0;
   double eye_height_m = 1.2;   // the box is centred on the driver's eye, not the axle
   double eye_forward_m = 1.3;  // from the pose's reference point
   double volume_m3() const { return length_m * width_m * height_m; }
