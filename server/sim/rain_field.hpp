@@ -67,7 +67,7 @@ struct RainFieldConfig {
   double behind_m = 2.0;         // the box's back, behind the eye
   double length_m = 24.0;        // along the car's heading
   double width_m = 12.0;
-  double height_m = 5.5;       // above the ground under the car
+  double height_m = 5.5;  // above the ground under the car
   // The field's own fixed step. A drop falls straight between steps, so a longer step moves it
   // the same; the renderer carries the drops on to a frame's time. (1/60 s cost the step thread
   // 0.3 ms a frame more: 33,000 drops at 25 mm/h, twice a frame.)
