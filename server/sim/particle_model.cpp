@@ -125,7 +125,7 @@ double ParticleModel::mass() const {
 // takes its move, and the particle the mean of its own. Later particles see where the earlier ones
 // left them. Parted one pair after another, each pair waited on the last one's square root and
 // division; at once, four pairs share them: 1.5 to 1.9 times as fast in a wiper's pile of 3,200
-// to 8,000 particles. (Summed rather than averaged, a particle pressed by several neighbours
+// to 4,100 particles. (Summed rather than averaged, a particle pressed by several neighbours
 // overshot: its largest move in a step doubled, and the blades left arcs of droplets behind.)
 // After a step's iterations the pile holds less overlap than one pair at a time left: the
 // overlaps' sum, in diameters, 686 against 748, of 1,379 before the step.
