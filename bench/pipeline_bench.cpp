@@ -31,6 +31,7 @@
 #include "server/session/session_registry.hpp"
 #include "server/sim/scenario.hpp"
 #include "tests/render/road_water_fixture.hpp"
+#include "tests/support/spray_drive.hpp"
 
 namespace {
 
@@ -193,7 +194,7 @@ json measure_step_thread(const sim::Scenario& scenario, int ticks, double warm_s
       sim::TrafficVehicle truck;
       truck.id = 1;
       truck.state = scenario.at(t + gap_m / speed).vehicle.value_or(*u.vehicle);
-      truck.size_m = {12.0, 2.5, 3.8};
+      truck.size_m = testing::kTruckSize;
       truck.vehicle_class = sim::VehicleClass::kTruck;
       u.traffic = std::vector<sim::TrafficVehicle>{truck};
     }

