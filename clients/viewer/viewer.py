@@ -16,7 +16,10 @@ HTTP endpoints:
   /api/frame/<view>.json         the latest frame's stats of one view
   /api/history.json              per view, samples of the last minute (for the plots)
   /frame/<view>.jpg[?after=N]    the latest JPEG (with ?after=N: waits up to 2 s for a newer one)
-  /stream/<view>                 MJPEG
+  /stream/<view>                 each new frame as it comes, over one held connection: MJPEG
+                                 (multipart/x-mixed-replace), each part with its X-Frame-Number;
+                                 the pages' frame loop (before a first frame: waits up to 2 s,
+                                 then 204)
   POST /api/follow               {"session_id": "..."} ("" = the first listed)
   POST /api/drive/start          {"width", "height", "fps"} all optional
   POST /api/drive/controls       {"throttle", "brake", "left", "right": bool,
@@ -965,7 +968,10 @@ class ViewerHandler(BaseHTTPRequestHandler):
     def _stream(self, view):
         generation, frame = self.frames.latest(view)
         if frame is None:
-            self._send(HTTPStatus.NOT_FOUND, "text/plain", b"no frame for this view\n")
+            # A page asks as soon as its session exists: its first frame may be on its way.
+            frame = self.frames.wait_newer(view, generation, -1, timeout_s=2.0)
+        if frame is None:
+            self._send(HTTPStatus.NO_CONTENT, "text/plain", b"")
             return
         self.send_response(HTTPStatus.OK)
         self.send_header("Content-Type", f"multipart/x-mixed-replace; boundary={BOUNDARY}")
@@ -974,6 +980,7 @@ class ViewerHandler(BaseHTTPRequestHandler):
         try:
             while frame is not None:
                 self.wfile.write(f"--{BOUNDARY}\r\nContent-Type: image/jpeg\r\n"
+                                 f"X-Frame-Number: {frame.frame_number}\r\n"
                                  f"Content-Length: {len(frame.jpeg)}\r\n\r\n".encode())
                 self.wfile.write(frame.jpeg)
                 self.wfile.write(b"\r\n")

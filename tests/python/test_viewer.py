@@ -62,6 +62,7 @@ class ViewerTest(unittest.TestCase):
 
     def test_follows_a_session_and_serves_its_views(self):
         self.assertEqual(self.status()["state"], "waiting")
+        self.assertEqual(self.get("/stream/cockpit")[0], 204)  # no session: no frame to wait for
         session_id = self.create_session()
         status = self.wait_for(lambda s: len(s["views"]) == 2 and s["views"][0]["fps"] > 0)
         self.assertEqual(status["session_id"], session_id)
@@ -86,7 +87,7 @@ class ViewerTest(unittest.TestCase):
         connection.request("GET", "/stream/cockpit")
         stream = connection.getresponse()
         self.assertTrue(stream.getheader("Content-Type").startswith("multipart/x-mixed-replace"))
-        sizes = []
+        sizes, numbers = [], []
         for _ in range(3):
             headers = {}
             line = stream.fp.readline()
@@ -97,8 +98,10 @@ class ViewerTest(unittest.TestCase):
             part = stream.fp.read(int(headers["content-length"]))
             self.assertEqual(headers["content-type"], "image/jpeg")
             sizes.append(Image.open(io.BytesIO(part)).size)
+            numbers.append(int(headers["x-frame-number"]))
             stream.fp.readline()  # the CRLF after the part
         self.assertEqual(sizes, [(64, 48)] * 3)
+        self.assertEqual(numbers, sorted(set(numbers)))  # each part a newer frame, numbered
 
         status = self.wait_for(lambda s: s["views"] and s["views"][0]["fps"] > 8)
         self.assertLess(status["views"][0]["fps"], 40)

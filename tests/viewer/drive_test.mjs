@@ -149,8 +149,8 @@ async function main() {
   const sessionId = drive0.session_id;
   log("driving session", sessionId);
   await waitFor("frames in both views", () => page.evaluate(() =>
-    Number(document.getElementById("img-cockpit").dataset.frame || 0) > 2 &&
-    Number(document.getElementById("img-road").dataset.frame || 0) > 2), 45_000);
+    Number(document.getElementById("frame-cockpit").dataset.frame || 0) > 2 &&
+    Number(document.getElementById("frame-road").dataset.frame || 0) > 2), 45_000);
   // The HUD's stats come from the viewer's own watch of the session, which starts after the drive's
   // first frames: as long a wait as for those.
   try {
@@ -163,8 +163,25 @@ async function main() {
     throw e;
   }
   await page.screenshot({path: path.join(shots, "01-drive-start.png")});
-  const cockpit = await page.$("#img-cockpit");
-  const frameBefore = Number(await page.$eval("#img-cockpit", (e) => e.dataset.frame));
+
+  // The frames' stream read from chunks cut anywhere: a byte at a time, and 7 bytes at a time.
+  const parsed = await page.evaluate(() => {
+    const enc = new TextEncoder();
+    const part = (n, body) => [enc.encode(`--b\r\nContent-Type: image/jpeg\r\nX-Frame-Number: ${n}\r\n` +
+                                          `Content-Length: ${body.length}\r\n\r\n`), body, enc.encode("\r\n")];
+    const bytes = new Uint8Array([].concat(part(41, new Uint8Array([1, 13, 10, 13, 10, 2])), part(42, new Uint8Array(300).fill(7)))
+                                   .flatMap((a) => [...a]));
+    return [1, 7].map((size) => {
+      const reader = new Downpour.MultipartReader(), got = [];
+      for (let i = 0; i < bytes.length; i += size) {
+        for (const p of reader.push(bytes.slice(i, i + size))) got.push(`${p.frame}:${p.body.length}:${p.body[1]}`);
+      }
+      return got.join(" ");
+    });
+  });
+  check(parsed.every((p) => p === "41:6:13 42:300:7"), `the stream's parts read from any chunks: ${parsed.join(" / ")}`);
+  const cockpit = await page.$("#frame-cockpit");
+  const frameBefore = Number(await page.$eval("#frame-cockpit", (e) => e.dataset.frame));
   const imageBefore = sha(await cockpit.screenshot());
   const speedBefore = (await json(base + "/api/drive/state.json")).speed_mps;
 
@@ -198,7 +215,7 @@ async function main() {
         "the server accepted the new rain rate");
 
   // The frames keep coming and the picture changed (the car moved, the rain, the wipers).
-  await waitFor("newer frames", () => page.$eval("#img-cockpit", (e, before) => Number(e.dataset.frame) > before + 5, frameBefore), 20_000);
+  await waitFor("newer frames", () => page.$eval("#frame-cockpit", (e, before) => Number(e.dataset.frame) > before + 5, frameBefore), 20_000);
   await sleep(1500);  // a second and a half of heavier rain and wipers for the screenshot
   const imageAfter = sha(await cockpit.screenshot());
   check(imageAfter !== imageBefore, "the cockpit image changed");
@@ -214,7 +231,7 @@ async function main() {
   await waitFor("the session in the list", () => room.$(`tr[data-session="${sessionId}"]`), 10_000);
   const rowText = await room.$eval(`tr[data-session="${sessionId}"]`, (e) => e.innerText);
   check(rowText.includes("realtime") && rowText.includes("YOURS"), "the control room lists the drive session as realtime and yours");
-  await waitFor("the followed session's views", () => room.$eval("#img-cockpit", (e) => Number(e.dataset.frame || 0) > 0), 20_000);
+  await waitFor("the followed session's views", () => room.$eval("#frame-cockpit", (e) => Number(e.dataset.frame || 0) > 0), 20_000);
   const plotsShown = await room.evaluate(() => typeof window.uPlot === "function");
   if (plotsShown) await waitFor("the plots", () => room.$$eval("#plots .uplot", (l) => l.length === 3), 10_000);
   await sleep(2500);  // a few plot points

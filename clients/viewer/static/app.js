@@ -70,11 +70,11 @@
         });
         pick.append(D.el("label", {}, [box2, " " + name]));
         if (hiddenViews.has(name)) continue;
-        const img = D.el("img", {alt: name + " view", id: "img-" + name});
+        const canvas = D.el("canvas", {role: "img", "aria-label": name + " view", id: "frame-" + name});
         box.append(D.el("figure", {class: "view", id: "view-" + name}, [
-          img, D.el("div", {class: "hud", id: "hud-" + name}), D.el("span", {class: "name", text: name.toUpperCase()}),
+          canvas, D.el("div", {class: "hud", id: "hud-" + name}), D.el("span", {class: "name", text: name.toUpperCase()}),
           D.el("figcaption", {id: "cap-" + name})]));
-        loops[name] = new D.FrameLoop(name, img);
+        loops[name] = new D.FrameLoop(name, canvas);
       }
       if (!names.length) box.append(D.el("div", {class: "empty", text: s.state === "watching" ? "waiting for the first frames…" : "Pick a session on the left, or drive it yourself."}));
     }

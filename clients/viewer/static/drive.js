@@ -114,7 +114,7 @@
       showDrive(d);
       banner("");
       for (const loop of loops) loop.stop();
-      loops = ["cockpit", "road"].map((v) => new D.FrameLoop(v, $("img-" + v)));
+      loops = ["cockpit", "road"].map((v) => new D.FrameLoop(v, $("frame-" + v)));
     } catch (e) {
       state = "idle";
       banner("Could not start a drive: " + e.message + " — retrying in 2 s.");
