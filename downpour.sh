@@ -73,8 +73,8 @@ web_packages() {
   done
 }
 
-# Software GL: one rasterizer thread per core unless the caller chose.
-export LP_NUM_THREADS=${LP_NUM_THREADS:-$(nproc)}
+# Software GL: the server and the benchmark run llvmpipe with the cores + 1 rasterizer threads
+# unless LP_NUM_THREADS says otherwise; the tests run it with 2.
 
 demo() {
   build

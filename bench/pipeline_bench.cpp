@@ -11,6 +11,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <functional>
 #include <map>
@@ -26,6 +27,7 @@
 #include "bench/stats.hpp"
 #include "server/encode/image_decoder.hpp"
 #include "server/encode/jpeg_encoder.hpp"
+#include "server/render/gl/egl_context.hpp"
 #include "server/render/renderer.hpp"
 #include "server/session/frame_scheduler.hpp"
 #include "server/session/session_registry.hpp"
@@ -633,6 +635,7 @@ int main(int argc, char** argv) {
   app.add_flag("--outputs", outputs,
                "with --client-background: also with the clean frame and the water mask asked for");
   CLI11_PARSE(app, argc, argv);
+  render::choose_rasterizer_threads(0);  // as the server chooses them
 
   if (check_renderer) {
     const auto renderer = render::Renderer::create(g_renderer);
@@ -655,6 +658,8 @@ int main(int argc, char** argv) {
   out["fps"] = scenario.fps;
   out["encoder_threads"] = g_encoder_threads;
   out["hardware_threads"] = std::thread::hardware_concurrency();
+  const char* rasterizer_threads = std::getenv("LP_NUM_THREADS");
+  out["rasterizer_threads"] = rasterizer_threads ? rasterizer_threads : "";
   std::map<std::string, json> pass_ms;  // by size
   if (client_background) {
     for (const std::string& size : sizes) {

@@ -19,6 +19,7 @@
 #include "server/app/log_format.hpp"
 #include "server/app/metrics.hpp"
 #include "server/app/server_config.hpp"
+#include "server/render/gl/egl_context.hpp"
 #include "server/rpc/call_status.hpp"
 #include "server/rpc/downpour_service.hpp"
 #include "server/rpc/malformed_request.hpp"
@@ -387,8 +388,7 @@ int main(int argc, char** argv) {
   rpc::Authenticator auth;
   std::shared_ptr<grpc::ServerCredentials> credentials;
   if (!app::load_security(*config, auth, credentials)) return 2;
-  if (config->render_threads > 0)
-    setenv("LP_NUM_THREADS", std::to_string(config->render_threads).c_str(), 1);
+  render::choose_rasterizer_threads(config->render_threads);
   const sigset_t signals = app::block_signals();
 
   session::FrameScheduler* scheduler_ptr = nullptr;

@@ -63,7 +63,7 @@ void add_serving_options(CLI::App& app, ServerConfig& c) {
       ->check(CLI::Range(1, 64))
       ->envname("DOWNPOUR_ENCODER_THREADS");
   app.add_option("--render-threads", c.render_threads,
-                 "llvmpipe rasterizer threads (LP_NUM_THREADS); 0 = as set")
+                 "llvmpipe rasterizer threads (LP_NUM_THREADS); 0 = as set, else the cores + 1")
       ->check(CLI::Range(0, 64))
       ->envname("DOWNPOUR_RENDER_THREADS");
 }

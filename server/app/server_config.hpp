@@ -25,7 +25,7 @@ struct ServerConfig {
   int max_height = 2160;
   double max_fps = 120.0;
   int encoder_threads = 1;
-  int render_threads = 0;  // LP_NUM_THREADS for llvmpipe; 0 = leave the environment's value
+  int render_threads = 0;  // LP_NUM_THREADS for llvmpipe; 0 = as set, else the cores + 1
   render::EglPlatformChoice renderer = render::EglPlatformChoice::kAuto;
   render::SpraySmoothing spray_smoothing = render::SpraySmoothing::kPlaneFit;
   std::string log_level = "info";

@@ -1,7 +1,11 @@
 #include "server/render/gl/egl_context.hpp"
 
+#include <algorithm>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
+#include <string>
+#include <thread>
 #include <vector>
 
 #include <EGL/egl.h>
@@ -58,6 +62,13 @@ EGLDisplay open_surfaceless_display() {
 }
 
 }  // namespace
+
+void choose_rasterizer_threads(int requested) {
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const std::string threads =
+      std::to_string(requested > 0 ? static_cast<unsigned>(requested) : cores + 1);
+  setenv("LP_NUM_THREADS", threads.c_str(), requested > 0 ? 1 : 0);
+}
 
 std::unique_ptr<EglContext> EglContext::create(EglPlatformChoice choice) {
   std::unique_ptr<EglContext> ctx(new EglContext());

@@ -14,6 +14,13 @@ enum class EglPlatformChoice {
   kSurfaceless,  // Mesa surfaceless only
 };
 
+// llvmpipe's rasterizer threads (LP_NUM_THREADS): `requested` where it is above 0, else the
+// environment's value where one is set, else the cores + 1. On two cores the third thread keeps a
+// core busy while the other threads wait on one another: the demo delivered a median 3.6% more
+// frames than with one thread a core (13 alternated pairs, 11 higher), at lower latency. Only
+// Mesa's software renderer reads it. Call before any thread starts (it sets the environment).
+void choose_rasterizer_threads(int requested);
+
 class EglContext {
  public:
   // Throws std::runtime_error with the reason when no context can be made.
