@@ -126,8 +126,10 @@ TickStats TickPolicy::stats(std::uint64_t session, Clock::time_point now) const 
   out.target_fps = s.fps;
   // Ticks within the last second over the time they span, once they span half a second (two
   // ticks close together say little). A slower session: its last few ticks within the long window.
-  // Either way no more than one over the time since the last tick, so a session that stops
-  // rendering shows its rate falling, not the rate it last had.
+  // Either way, once the time since the last tick is longer than any interval between those ticks,
+  // no more than one over it: a session that stops rendering shows its rate falling, not the rate
+  // it last had. (Not before: beside a heavy session a light one ticks in bursts, and a wait as
+  // long as its usual ones is no slowdown.)
   std::size_t recent = 0;
   for (auto t : s.recent) recent += now - t <= kRateWindow;
   const bool fast = recent >= 2 && s.recent.back() - s.recent[s.recent.size() - recent] >=
@@ -137,12 +139,18 @@ TickStats TickPolicy::stats(std::uint64_t session, Clock::time_point now) const 
     for (auto t : s.recent) recent += now - t <= kSlowRateWindow;
   }
   if (recent >= 2) {
-    const Clock::time_point first = s.recent[s.recent.size() - recent];
-    const double span = std::chrono::duration<double>(s.recent.back() - first).count();
-    const double since_last = std::chrono::duration<double>(now - s.recent.back()).count();
+    const std::size_t first = s.recent.size() - recent;
+    const double span = std::chrono::duration<double>(s.recent.back() - s.recent[first]).count();
+    Clock::duration longest{};
+    for (std::size_t i = first + 1; i < s.recent.size(); ++i)
+      longest = std::max(longest, s.recent[i] - s.recent[i - 1]);
+    const Clock::duration since_last = now - s.recent.back();
     if (span > 0.0) {
       out.achieved_fps = (recent - 1) / span;
-      if (since_last > 0.0) out.achieved_fps = std::min(out.achieved_fps, 1.0 / since_last);
+      if (since_last > longest) {
+        out.achieved_fps =
+            std::min(out.achieved_fps, 1.0 / std::chrono::duration<double>(since_last).count());
+      }
     }
   }
   return out;
