@@ -16,10 +16,12 @@ HTTP endpoints:
   /api/frame/<view>.json         the latest frame's stats of one view
   /api/history.json              per view, samples of the last minute (for the plots)
   /frame/<view>.jpg[?after=N]    the latest JPEG (with ?after=N: waits up to 2 s for a newer one)
-  /stream/<view>                 each new frame as it comes, over one held connection: MJPEG
-                                 (multipart/x-mixed-replace), each part with its X-Frame-Number;
-                                 the pages' frame loop (before a first frame: waits up to 2 s,
-                                 then 204)
+  /stream/<view>[,<view>...]     each new frame of these views as it comes, over one held
+                                 connection: MJPEG (multipart/x-mixed-replace), each part with its
+                                 X-View and X-Frame-Number; the pages' frames, all of a page's views
+                                 on one connection (a browser holds six to a host). Before a first
+                                 frame it waits up to 2 s, then answers 204 (at once when no
+                                 session is followed)
   POST /api/follow               {"session_id": "..."} ("" = the first listed)
   POST /api/drive/start          {"width", "height", "fps"} all optional
   POST /api/drive/controls       {"throttle", "brake", "left", "right": bool,
@@ -33,7 +35,9 @@ import collections
 import json
 import math
 import os
+import select
 import signal
+import socket
 import sys
 import threading
 import time
@@ -54,6 +58,8 @@ MAX_BODY_BYTES = 64 * 1024  # a POST's JSON body
 FPS_WINDOW_S = 2.0
 RETRY_S = 0.5
 SLOW_REQUEST_S = 2.0
+MAX_STREAM_VIEWS = 8   # views on one /stream connection
+STREAM_IDLE_S = 5.0    # a stream without frames this long checks that its page is still there
 LIST_PERIOD_S = 1.0
 HISTORY_S = 60.0
 HISTORY_STEP_S = 0.25
@@ -238,6 +244,22 @@ class LatestFrames:
         """(generation, the view's latest frame or None)."""
         with self.condition:
             return self.generation, self._frames.get(view)
+
+    def wait_any_newer(self, views, generation, seen, timeout_s):
+        """[(view, frame)] of those views whose latest frame is not the one `seen` names (view ->
+        frame number); None once that stream is gone or no session is followed; [] after
+        timeout_s."""
+        deadline = time.monotonic() + timeout_s
+        with self.condition:
+            while True:
+                if self.closed or self.generation != generation or self.state != "watching":
+                    return None
+                newer = [(v, f) for v in views for f in [self._frames.get(v)]
+                         if f is not None and f.frame_number != seen.get(v)]
+                remaining = deadline - time.monotonic()
+                if newer or remaining <= 0:
+                    return newer
+                self.condition.wait(remaining)
 
     def wait_newer(self, view, generation, frame_number, timeout_s=None):
         """The view's next frame after frame_number; None once that stream or view is gone (or
@@ -869,7 +891,7 @@ class ViewerHandler(BaseHTTPRequestHandler):
         elif path.startswith("/frame/") and path.endswith(".jpg"):
             self._frame(path[len("/frame/"):-len(".jpg")].lower(), params.get("after"))
         elif path.startswith("/stream/"):
-            self._stream(path[len("/stream/"):].lower())
+            self._stream(path[len("/stream/"):].lower().split(","))
         else:
             self._send(HTTPStatus.NOT_FOUND, "text/plain", b"not found\n")
 
@@ -950,8 +972,8 @@ class ViewerHandler(BaseHTTPRequestHandler):
     def _frame(self, view, after):
         generation, frame = self.frames.latest(view)
         if after is not None and (frame is None or str(frame.frame_number) == after):
-            # The page's frame loop: wait for the next frame (or the first) up to 2 s; none yet
-            # is "204 No Content", not an error.
+            # A client's frame loop: wait for the next frame (or the first) up to 2 s; none yet
+            # is "204 No Content", not an error. (The pages read /stream.)
             frame = self.frames.wait_newer(view, generation, frame.frame_number if frame else -1,
                                            timeout_s=2.0)
             if frame is None:
@@ -965,30 +987,44 @@ class ViewerHandler(BaseHTTPRequestHandler):
         self._send(HTTPStatus.OK, "image/jpeg", frame.jpeg,
                    {"X-Frame-Number": str(frame.frame_number), "X-Session": frame.session_id})
 
-    def _stream(self, view):
-        generation, frame = self.frames.latest(view)
-        if frame is None:
-            # A page asks as soon as its session exists: its first frame may be on its way.
-            frame = self.frames.wait_newer(view, generation, -1, timeout_s=2.0)
-        if frame is None:
+    def _stream(self, views):
+        views = list(dict.fromkeys(v for v in views if v))[:MAX_STREAM_VIEWS]
+        generation, _ = self.frames.latest("")
+        seen = {}
+        # A page asks as soon as its session exists: its first frames may be on their way.
+        newer = self.frames.wait_any_newer(views, generation, seen, timeout_s=2.0) if views else None
+        if not newer:
             self._send(HTTPStatus.NO_CONTENT, "text/plain", b"")
             return
-        self.send_response(HTTPStatus.OK)
-        self.send_header("Content-Type", f"multipart/x-mixed-replace; boundary={BOUNDARY}")
-        self.send_header("Cache-Control", "no-store")
-        self.end_headers()
         try:
-            while frame is not None:
-                self.wfile.write(f"--{BOUNDARY}\r\nContent-Type: image/jpeg\r\n"
-                                 f"X-Frame-Number: {frame.frame_number}\r\n"
-                                 f"Content-Length: {len(frame.jpeg)}\r\n\r\n".encode())
-                self.wfile.write(frame.jpeg)
-                self.wfile.write(b"\r\n")
+            self.send_response(HTTPStatus.OK)
+            self.send_header("Content-Type", f"multipart/x-mixed-replace; boundary={BOUNDARY}")
+            self.send_header("Cache-Control", "no-store")
+            self.end_headers()
+            while newer is not None:
+                for view, frame in newer:
+                    self.wfile.write(f"--{BOUNDARY}\r\nContent-Type: image/jpeg\r\n"
+                                     f"X-View: {view}\r\nX-Frame-Number: {frame.frame_number}\r\n"
+                                     f"Content-Length: {len(frame.jpeg)}\r\n\r\n".encode())
+                    self.wfile.write(frame.jpeg)
+                    self.wfile.write(b"\r\n")
+                    seen[view] = frame.frame_number
                 self.wfile.flush()
-                frame = self.frames.wait_newer(view, generation, frame.frame_number)
+                newer = self.frames.wait_any_newer(views, generation, seen, STREAM_IDLE_S)
+                if newer == [] and self._client_gone():
+                    break
         except (BrokenPipeError, ConnectionResetError):
             pass
         self.close_connection = True
+
+    def _client_gone(self):
+        """Whether the page hung up: it sends nothing after its request, so a readable socket
+        means the end of the connection (a paused session's stream would wait on else)."""
+        try:
+            readable, _, _ = select.select([self.connection], [], [], 0)
+            return bool(readable) and self.connection.recv(1, socket.MSG_PEEK) == b""
+        except OSError:
+            return True
 
     def _json(self, value, status=HTTPStatus.OK):
         self._send(status, "application/json", json.dumps(value).encode())
@@ -1016,13 +1052,13 @@ class ViewerHandler(BaseHTTPRequestHandler):
         super().handle_one_request()
         took = time.monotonic() - start
         path = (getattr(self, "path", "") or "").split("?", 1)[0]
-        if took > SLOW_REQUEST_S and path and not path.startswith("/frame/"):
+        if took > SLOW_REQUEST_S and path and not path.startswith(("/frame/", "/stream/")):
             log(f"slow request: {getattr(self, 'command', '')} {path} took {took:.1f} s")
 
 
 class ViewerServer(ThreadingHTTPServer):
-    # Every request is a connection of its own (HTTP/1.0): a page opens some fifty a second (two
-    # views' frames, its controls, its polls). socketserver's backlog of 5 overflows when a loaded
+    # Every request is a connection of its own (HTTP/1.0): a page opens some ten a second (its
+    # controls and its polls; its frames come over one held stream). socketserver's backlog of 5 overflows when a loaded
     # machine is slow to accept, and a connection refused that way waits for the browser's
     # retries (1, 2, 4, 8 s: a page unheard for 15 s loses its drive).
     request_queue_size = 128

@@ -384,11 +384,12 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   const auto config = app::parse_config(argc, argv, &exit_code);
   if (!config) return exit_code;
+  // It sets the environment: before anything that may start a thread (gRPC's credentials).
+  render::choose_rasterizer_threads(config->render_threads);
   app::set_up_logging(*config);
   rpc::Authenticator auth;
   std::shared_ptr<grpc::ServerCredentials> credentials;
   if (!app::load_security(*config, auth, credentials)) return 2;
-  render::choose_rasterizer_threads(config->render_threads);
   const sigset_t signals = app::block_signals();
 
   session::FrameScheduler* scheduler_ptr = nullptr;

@@ -99,16 +99,39 @@ class ViewerTest(unittest.TestCase):
             self.assertEqual(headers["content-type"], "image/jpeg")
             sizes.append(Image.open(io.BytesIO(part)).size)
             numbers.append(int(headers["x-frame-number"]))
+            self.assertEqual(headers["x-view"], "cockpit")
             stream.fp.readline()  # the CRLF after the part
         self.assertEqual(sizes, [(64, 48)] * 3)
         self.assertEqual(numbers, sorted(set(numbers)))  # each part a newer frame, numbered
+
+        # A page's views on one connection: each view's parts, each named.
+        both = http.client.HTTPConnection("127.0.0.1", self.port, timeout=10)
+        both.request("GET", "/stream/cockpit,rain")
+        parts = both.getresponse()
+        seen = {}
+        while len(seen) < 2 or min(len(n) for n in seen.values()) < 2:
+            headers = {}
+            line = parts.fp.readline()
+            while line.strip() != b"":
+                key, _, value = line.decode().partition(":")
+                headers[key.strip().lower()] = value.strip()
+                line = parts.fp.readline()
+            size = Image.open(io.BytesIO(parts.fp.read(int(headers["content-length"])))).size
+            parts.fp.readline()
+            self.assertEqual(size, {"cockpit": (64, 48), "rain": (32, 16)}[headers["x-view"]])
+            seen.setdefault(headers["x-view"], []).append(int(headers["x-frame-number"]))
+        for view, numbers in seen.items():
+            self.assertEqual(numbers, sorted(set(numbers)), view)
 
         status = self.wait_for(lambda s: s["views"] and s["views"][0]["fps"] > 8)
         self.assertLess(status["views"][0]["fps"], 40)
 
         self.fake.CloseSession(pb.CloseSessionRequest(session_id=session_id), None)
         self.wait_for(lambda s: s["state"] == "waiting" and not s["views"])
-        self.assertEqual(stream.fp.read(), b"")  # the MJPEG stream ends with its session
+        # The streams end with their session (read to the end: the parts written till then).
+        for ending in (stream, parts):
+            rest = ending.fp.read()
+            self.assertTrue(rest == b"" or rest.endswith(b"\r\n"), rest[-40:])
 
         second = self.create_session()
         status = self.wait_for(lambda s: s["session_id"] == second and s["views"])

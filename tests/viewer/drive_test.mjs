@@ -167,19 +167,19 @@ async function main() {
   // The frames' stream read from chunks cut anywhere: a byte at a time, and 7 bytes at a time.
   const parsed = await page.evaluate(() => {
     const enc = new TextEncoder();
-    const part = (n, body) => [enc.encode(`--b\r\nContent-Type: image/jpeg\r\nX-Frame-Number: ${n}\r\n` +
+    const part = (n, body) => [enc.encode(`--b\r\nContent-Type: image/jpeg\r\nX-View: v${n}\r\nX-Frame-Number: ${n}\r\n` +
                                           `Content-Length: ${body.length}\r\n\r\n`), body, enc.encode("\r\n")];
     const bytes = new Uint8Array([].concat(part(41, new Uint8Array([1, 13, 10, 13, 10, 2])), part(42, new Uint8Array(300).fill(7)))
                                    .flatMap((a) => [...a]));
     return [1, 7].map((size) => {
       const reader = new Downpour.MultipartReader(), got = [];
       for (let i = 0; i < bytes.length; i += size) {
-        for (const p of reader.push(bytes.slice(i, i + size))) got.push(`${p.frame}:${p.body.length}:${p.body[1]}`);
+        for (const p of reader.push(bytes.slice(i, i + size))) got.push(`${p.view}:${p.frame}:${p.body.length}:${p.body[1]}`);
       }
       return got.join(" ");
     });
   });
-  check(parsed.every((p) => p === "41:6:13 42:300:7"), `the stream's parts read from any chunks: ${parsed.join(" / ")}`);
+  check(parsed.every((p) => p === "v41:41:6:13 v42:42:300:7"), `the stream's parts read from any chunks: ${parsed.join(" / ")}`);
   const cockpit = await page.$("#frame-cockpit");
   const frameBefore = Number(await page.$eval("#frame-cockpit", (e) => e.dataset.frame));
   const imageBefore = sha(await cockpit.screenshot());

@@ -3,7 +3,7 @@
 (() => {
   const D = Downpour, $ = D.$;
   const hiddenViews = new Set();
-  let shownKey = "", loops = {}, sessionsKey = "", status = null;
+  let shownKey = "", frameLoop = null, sessionsKey = "", status = null;
   const plots = new D.Plots($("plots"), $("plots-note"));
 
   function banner(text, info) {
@@ -52,8 +52,8 @@
     const key = s.generation + ":" + names.join(",") + ":" + [...hiddenViews].join(",");
     if (key !== shownKey) {
       shownKey = key;
-      for (const loop of Object.values(loops)) loop.stop();
-      loops = {};
+      if (frameLoop) frameLoop.stop();
+      const canvases = {};
       const box = $("views");
       box.innerHTML = "";
       const pick = $("viewpick");
@@ -74,8 +74,9 @@
         box.append(D.el("figure", {class: "view", id: "view-" + name}, [
           canvas, D.el("div", {class: "hud", id: "hud-" + name}), D.el("span", {class: "name", text: name.toUpperCase()}),
           D.el("figcaption", {id: "cap-" + name})]));
-        loops[name] = new D.FrameLoop(name, canvas);
+        canvases[name] = canvas;
       }
+      frameLoop = new D.FrameLoop(canvases);
       if (!names.length) box.append(D.el("div", {class: "empty", text: s.state === "watching" ? "waiting for the first frames…" : "Pick a session on the left, or drive it yourself."}));
     }
     const mine = s.drive && s.drive.session_id === s.session_id && s.session_id;

@@ -40,18 +40,19 @@ const Downpour = (() => {
   const num = (v, digits = 1) => (v === undefined || v === null || !isFinite(v)) ? "–" : Number(v).toFixed(digits);
   const pct = (v) => num(100 * (v || 0), 1) + "%";
 
-  // Shows a view's frames in a canvas as they come. /stream/<view> sends each new frame as one
-  // part of a multipart answer over one held connection (MultipartReader); each is decoded off
-  // the page's thread (createImageBitmap) and drawn. A frame that comes while the last is still
-  // being decoded waits in its place, and a newer one replaces it: the canvas shows the newest,
-  // and a slow page never piles frames up. (A request for each frame cost headless Chromium
-  // about twice the CPU for two 480x270 views at 20 fps.)
+  // Shows views' frames in canvases as they come ({view: canvas}). /stream/<view>,<view> sends
+  // each new frame of those views as one part of a multipart answer, over one held connection for
+  // all of a page's views (a browser holds six to a host; MultipartReader); each is decoded off
+  // the page's thread (createImageBitmap) and drawn. A view's frame that comes while its last is
+  // still being decoded waits in its place, and a newer one replaces it: a canvas shows the
+  // newest, and a slow page never piles frames up. (A request for each frame cost headless
+  // Chromium about twice the CPU for two 480x270 views at 20 fps.)
   class FrameLoop {
-    constructor(view, canvas, onFrame) {
-      this.view = view; this.canvas = canvas; this.onFrame = onFrame;
+    constructor(canvases, onFrame) {
+      this.canvases = canvases; this.onFrame = onFrame;
       this.running = true; this.frames = 0;
       this.abort = new AbortController();
-      this.decoding = false; this.waiting = null;
+      this.decoding = {}; this.waiting = {};
       this.loop();
     }
     stop() {
@@ -59,18 +60,20 @@ const Downpour = (() => {
       this.abort.abort();
     }
     async loop() {
-      while (this.running) {
+      const views = Object.keys(this.canvases);
+      const url = "/stream/" + views.map(encodeURIComponent).join(",");
+      while (this.running && views.length) {
+        let parts = 0;
         try {
-          const response = await fetch("/stream/" + encodeURIComponent(this.view),
-                                       {cache: "no-store", signal: this.abort.signal});
-          // 204: no frame came in 2 s (or no session is followed); 404: no such view.
+          const response = await fetch(url, {cache: "no-store", signal: this.abort.signal});
+          // 204: no frame came in 2 s, or no session is followed.
           if (response.status !== 200 || !response.body) { await sleep(400); continue; }
-          const reader = response.body.getReader(), parts = new MultipartReader();
+          const reader = response.body.getReader(), reading = new MultipartReader();
           try {
             for (;;) {
               const {value, done} = await reader.read();
               if (done || !this.running) break;
-              for (const part of parts.push(value)) this.show(part);
+              for (const part of reading.push(value)) { ++parts; this.show(part.view || views[0], part); }
             }
           } finally {
             reader.cancel().catch(() => {});  // closes the connection (a part it could not read)
@@ -78,33 +81,36 @@ const Downpour = (() => {
         } catch (e) {
           if (this.running) await sleep(500);
         }
+        if (parts < 2 && this.running) await sleep(400);  // a stream that ends at once: the viewer closing
       }
     }
-    show(part) {
-      if (this.decoding) { this.waiting = part; return; }
-      this.decoding = true;
+    show(view, part) {
+      const canvas = this.canvases[view];
+      if (!canvas) return;
+      if (this.decoding[view]) { this.waiting[view] = part; return; }
+      this.decoding[view] = true;
       createImageBitmap(new Blob([part.body], {type: "image/jpeg"})).then((bitmap) => {
         if (this.running) {
-          if (this.canvas.width !== bitmap.width || this.canvas.height !== bitmap.height) {
-            this.canvas.width = bitmap.width; this.canvas.height = bitmap.height;
+          if (canvas.width !== bitmap.width || canvas.height !== bitmap.height) {
+            canvas.width = bitmap.width; canvas.height = bitmap.height;
           }
-          this.canvas.getContext("2d").drawImage(bitmap, 0, 0);
+          canvas.getContext("2d").drawImage(bitmap, 0, 0);
           this.frames += 1;
-          this.canvas.dataset.frame = part.frame;
-          if (this.onFrame) this.onFrame(part.frame);
+          canvas.dataset.frame = part.frame;
+          if (this.onFrame) this.onFrame(view, part.frame);
         }
         bitmap.close();
       }, () => {}).finally(() => {
-        this.decoding = false;
-        const next = this.waiting;
-        this.waiting = null;
-        if (next && this.running) this.show(next);
+        this.decoding[view] = false;
+        const next = this.waiting[view];
+        this.waiting[view] = null;
+        if (next && this.running) this.show(view, next);
       });
     }
   }
 
   // The parts of the viewer's multipart stream, from its bytes as they arrive in chunks of any
-  // size: "--boundary", header lines (Content-Length and X-Frame-Number among them), a blank
+  // size: "--boundary", header lines (Content-Length, X-View and X-Frame-Number), a blank
   // line, the body, CRLF. Throws on a part it cannot read (the loop then opens a new stream).
   class MultipartReader {
     constructor() { this.buffer = new Uint8Array(0); this.text = new TextDecoder(); }
@@ -127,7 +133,8 @@ const Downpour = (() => {
         const first = end + 4, last = first + Number(length[1]);
         if (b.length < last + 2) break;  // the body and its CRLF are still coming
         const frame = (/^x-frame-number:\s*(\d+)\s*$/im.exec(head) || [])[1] || "";
-        parts.push({frame, body: b.subarray(first, last)});
+        const view = (/^x-view:\s*(\S+)\s*$/im.exec(head) || [])[1] || "";
+        parts.push({view, frame, body: b.subarray(first, last)});
         this.buffer = b.subarray(last + 2);
       }
       return parts;

@@ -15,7 +15,7 @@
   const WIPER_KEYS = {Digit0: "off", Digit1: "intermittent", Digit2: "low", Digit3: "high", Digit4: "single",
                       Numpad0: "off", Numpad1: "intermittent", Numpad2: "low", Numpad3: "high", Numpad4: "single"};
   const keys = {throttle: false, brake: false, left: false, right: false};
-  let targetFps = 20, sessionId = "", state = "idle", loops = [], pendingWeather = null, pendingWipers = null;
+  let targetFps = 20, sessionId = "", state = "idle", frameLoop = null, pendingWeather = null, pendingWipers = null;
   // Drives begun on this page: a status asked for before the latest one was driving tells nothing
   // of it (on a loaded machine, a status asked for while the session was being made came back
   // after the start's answer, said "no session", and stopped the page's controls: the viewer then
@@ -113,8 +113,8 @@
       setSliders(d.weather);
       showDrive(d);
       banner("");
-      for (const loop of loops) loop.stop();
-      loops = ["cockpit", "road"].map((v) => new D.FrameLoop(v, $("frame-" + v)));
+      if (frameLoop) frameLoop.stop();
+      frameLoop = new D.FrameLoop({cockpit: $("frame-cockpit"), road: $("frame-road")});
     } catch (e) {
       state = "idle";
       banner("Could not start a drive: " + e.message + " — retrying in 2 s.");
@@ -124,8 +124,8 @@
 
   async function stop() {
     state = "stopped";
-    for (const loop of loops) loop.stop();
-    loops = [];
+    if (frameLoop) frameLoop.stop();
+    frameLoop = null;
     try { await D.postJSON("/api/drive/stop", {reason: "stopped on the page"}); } catch (e) { /* shown below */ }
     $("start").hidden = false; $("stop").hidden = true;
     banner("Session closed. Start a new drive to go on.", true);

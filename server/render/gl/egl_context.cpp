@@ -1,5 +1,7 @@
 #include "server/render/gl/egl_context.hpp"
 
+#include <sched.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
@@ -64,7 +66,11 @@ EGLDisplay open_surfaceless_display() {
 }  // namespace
 
 void choose_rasterizer_threads(int requested) {
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  // The cores this process may run on (taskset, a container's cpuset), not all the machine's.
+  cpu_set_t allowed;
+  const unsigned cores = sched_getaffinity(0, sizeof allowed, &allowed) == 0
+                             ? static_cast<unsigned>(CPU_COUNT(&allowed))
+                             : std::max(1u, std::thread::hardware_concurrency());
   const std::string threads =
       std::to_string(requested > 0 ? static_cast<unsigned>(requested) : cores + 1);
   setenv("LP_NUM_THREADS", threads.c_str(), requested > 0 ? 1 : 0);
