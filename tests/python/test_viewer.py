@@ -20,6 +20,19 @@ REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 VIEWER = os.path.join(REPO, "clients", "viewer", "viewer.py")
 
 
+def read_part(stream):
+    """The next part of a multipart stream: (its headers, lower-cased; its body)."""
+    headers = {}
+    line = stream.fp.readline()
+    while line.strip() != b"":
+        key, _, value = line.decode().partition(":")
+        headers[key.strip().lower()] = value.strip()
+        line = stream.fp.readline()
+    body = stream.fp.read(int(headers["content-length"]))
+    stream.fp.readline()  # the CRLF after the part
+    return headers, body
+
+
 class ViewerTest(unittest.TestCase):
     def setUp(self):
         self.server, self.fake, target = fake_server.start()
@@ -89,18 +102,11 @@ class ViewerTest(unittest.TestCase):
         self.assertTrue(stream.getheader("Content-Type").startswith("multipart/x-mixed-replace"))
         sizes, numbers = [], []
         for _ in range(3):
-            headers = {}
-            line = stream.fp.readline()
-            while line.strip() != b"":
-                key, _, value = line.decode().partition(":")
-                headers[key.strip().lower()] = value.strip()
-                line = stream.fp.readline()
-            part = stream.fp.read(int(headers["content-length"]))
+            headers, part = read_part(stream)
             self.assertEqual(headers["content-type"], "image/jpeg")
             sizes.append(Image.open(io.BytesIO(part)).size)
             numbers.append(int(headers["x-frame-number"]))
             self.assertEqual(headers["x-view"], "cockpit")
-            stream.fp.readline()  # the CRLF after the part
         self.assertEqual(sizes, [(64, 48)] * 3)
         self.assertEqual(numbers, sorted(set(numbers)))  # each part a newer frame, numbered
 
@@ -110,14 +116,8 @@ class ViewerTest(unittest.TestCase):
         parts = both.getresponse()
         seen = {}
         while len(seen) < 2 or min(len(n) for n in seen.values()) < 2:
-            headers = {}
-            line = parts.fp.readline()
-            while line.strip() != b"":
-                key, _, value = line.decode().partition(":")
-                headers[key.strip().lower()] = value.strip()
-                line = parts.fp.readline()
-            size = Image.open(io.BytesIO(parts.fp.read(int(headers["content-length"])))).size
-            parts.fp.readline()
+            headers, part = read_part(parts)
+            size = Image.open(io.BytesIO(part)).size
             self.assertEqual(size, {"cockpit": (64, 48), "rain": (32, 16)}[headers["x-view"]])
             seen.setdefault(headers["x-view"], []).append(int(headers["x-frame-number"]))
         for view, numbers in seen.items():
