@@ -261,26 +261,6 @@ class LatestFrames:
                     return newer
                 self.condition.wait(remaining)
 
-    def wait_newer(self, view, generation, frame_number, timeout_s=None):
-        """The view's next frame after frame_number; None once that stream or view is gone (or
-        after timeout_s)."""
-        deadline = None if timeout_s is None else time.monotonic() + timeout_s
-        with self.condition:
-            while True:
-                frame = self._frames.get(view)
-                if self.closed or self.generation != generation or (
-                        frame is None and self.state != "watching"):
-                    return None
-                if frame is not None and frame.frame_number != frame_number:
-                    return frame
-                if deadline is None:
-                    self.condition.wait()
-                else:
-                    remaining = deadline - time.monotonic()
-                    if remaining <= 0:
-                        return None
-                    self.condition.wait(remaining)
-
     def status(self):
         with self.condition:
             views = []
@@ -974,8 +954,9 @@ class ViewerHandler(BaseHTTPRequestHandler):
         if after is not None and (frame is None or str(frame.frame_number) == after):
             # A client's frame loop: wait for the next frame (or the first) up to 2 s; none yet
             # is "204 No Content", not an error. (The pages read /stream.)
-            frame = self.frames.wait_newer(view, generation, frame.frame_number if frame else -1,
-                                           timeout_s=2.0)
+            newer = self.frames.wait_any_newer([view], generation,
+                                               {view: frame.frame_number} if frame else {}, 2.0)
+            frame = newer[0][1] if newer else None
             if frame is None:
                 _, frame = self.frames.latest(view)
             if frame is None:
@@ -989,10 +970,12 @@ class ViewerHandler(BaseHTTPRequestHandler):
 
     def _stream(self, views):
         views = list(dict.fromkeys(v for v in views if v))[:MAX_STREAM_VIEWS]
-        generation, _ = self.frames.latest("")
         seen = {}
-        # A page asks as soon as its session exists: its first frames may be on their way.
-        newer = self.frames.wait_any_newer(views, generation, seen, timeout_s=2.0) if views else None
+        newer = None
+        if views:
+            generation, _ = self.frames.latest(views[0])
+            # A page asks as soon as its session exists: its first frames may be on their way.
+            newer = self.frames.wait_any_newer(views, generation, seen, timeout_s=2.0)
         if not newer:
             self._send(HTTPStatus.NO_CONTENT, "text/plain", b"")
             return
@@ -1058,9 +1041,9 @@ class ViewerHandler(BaseHTTPRequestHandler):
 
 class ViewerServer(ThreadingHTTPServer):
     # Every request is a connection of its own (HTTP/1.0): a page opens some ten a second (its
-    # controls and its polls; its frames come over one held stream). socketserver's backlog of 5 overflows when a loaded
-    # machine is slow to accept, and a connection refused that way waits for the browser's
-    # retries (1, 2, 4, 8 s: a page unheard for 15 s loses its drive).
+    # controls and its polls; its frames come over one held stream). socketserver's backlog of 5
+    # overflows when a loaded machine is slow to accept, and a connection refused that way waits
+    # for the browser's retries (1, 2, 4, 8 s: a page unheard for 15 s loses its drive).
     request_queue_size = 128
     daemon_threads = True
 

@@ -48,9 +48,9 @@ const Downpour = (() => {
   // newest, and a slow page never piles frames up. (A request for each frame cost headless
   // Chromium about twice the CPU for two 480x270 views at 20 fps.)
   class FrameLoop {
-    constructor(canvases, onFrame) {
-      this.canvases = canvases; this.onFrame = onFrame;
-      this.running = true; this.frames = 0;
+    constructor(canvases) {
+      this.canvases = canvases;
+      this.running = true;
       this.abort = new AbortController();
       this.decoding = {}; this.waiting = {};
       this.loop();
@@ -95,9 +95,7 @@ const Downpour = (() => {
             canvas.width = bitmap.width; canvas.height = bitmap.height;
           }
           canvas.getContext("2d").drawImage(bitmap, 0, 0);
-          this.frames += 1;
           canvas.dataset.frame = part.frame;
-          if (this.onFrame) this.onFrame(view, part.frame);
         }
         bitmap.close();
       }, () => {}).finally(() => {
