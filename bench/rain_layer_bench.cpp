@@ -1,7 +1,8 @@
 // The rain layer alone (rain_layer.hpp): the CPU's streaks for the COCKPIT view of the standard
 // scene, without GL, so that its cost can be measured quietly and compared change by change.
 //   downpour-rain-layer-bench [--counts N ...] [--frames F] [--size WxH] [--no-splashes]
-// For each rain_streak_count, the scene's drive is warmed for 2 s and the layer is built for F
+//                             [--warm-seconds S]
+// For each rain_streak_count, the scene's drive is warmed for S s (2 by default) and the layer is built for F
 // frames (the simulation stepping between them); prints one JSON line per count: the streaks drawn
 // and the splashes alive (medians), and the layer's median and 90th-percentile milliseconds.
 #include <algorithm>
@@ -32,11 +33,14 @@ int main(int argc, char** argv) {
   int frames = 60;
   std::string size = "640x360";
   bool splashes_too = true;
+  double warm_s = 2.0;
   CLI::App app{"Downpour rain layer benchmark: the CPU streaks of one view, as JSON lines"};
   app.add_option("--counts", counts, "rain_streak_count values");
   app.add_option("--frames", frames)->check(CLI::Range(5, 100000));
   app.add_option("--size", size, "the view's WIDTHxHEIGHT");
   app.add_flag("!--no-splashes", splashes_too, "the streaks alone");
+  app.add_option("--warm-seconds", warm_s, "the scene's drive before measuring")
+      ->check(CLI::Range(0.0, 600.0));
   CLI11_PARSE(app, argc, argv);
   int width = 0, height = 0;
   if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16) {
@@ -61,7 +65,7 @@ int main(int argc, char** argv) {
       simulation.apply(scenario.at(simulation.state().sim_time_s + dt));
       simulation.advance(dt);
     };
-    for (double t = 0.0; t < 2.0; t += dt) step();
+    for (double t = 0.0; t < warm_s; t += dt) step();
     render::RainLayer layer;
     std::vector<render::RainOccluder> occluders;
     std::vector<render::RainLamp> lamps;
