@@ -2,9 +2,10 @@
 // scene, without GL, so that its cost can be measured quietly and compared change by change.
 //   downpour-rain-layer-bench [--counts N ...] [--frames F] [--size WxH] [--no-splashes]
 //                             [--warm-seconds S]
-// For each rain_streak_count, the scene's drive is warmed for S s (2 by default) and the layer is built for F
-// frames (the simulation stepping between them); prints one JSON line per count: the streaks drawn
-// and the splashes alive (medians), and the layer's median and 90th-percentile milliseconds.
+// For each rain_streak_count, the scene's drive is warmed for S s (2 by default) and the layer is
+// built for F frames (the simulation stepping between them); prints one JSON line per count: the
+// streaks drawn and the splashes alive (medians), and the layer's median and 90th-percentile
+// milliseconds.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
