@@ -190,17 +190,7 @@ json measure_step_thread(const sim::Scenario& scenario, int ticks, double warm_s
   sim::Simulation simulation(scenario.seed, scenario.at(0.0), config);
   const double dt = 1.0 / scenario.fps;
   auto update = [&](double t) {
-    sim::Update u = scenario.at(t);
-    if (gap_m > 0.0 && u.vehicle) {
-      const double speed = std::max(glm::length(u.vehicle->velocity_mps), 1.0);
-      sim::TrafficVehicle truck;
-      truck.id = 1;
-      truck.state = scenario.at(t + gap_m / speed).vehicle.value_or(*u.vehicle);
-      truck.size_m = testing::kTruckSize;
-      truck.vehicle_class = sim::VehicleClass::kTruck;
-      u.traffic = std::vector<sim::TrafficVehicle>{truck};
-    }
-    return u;
+    return gap_m > 0.0 ? sim::behind_truck(scenario, t, gap_m) : scenario.at(t);
   };
   for (int i = 0; i < static_cast<int>(warm_s * scenario.fps); ++i) {
     simulation.apply(update(simulation.state().sim_time_s + dt));

@@ -11,7 +11,7 @@
 #include "server/render/cpu/atmosphere.hpp"
 #include "server/render/cpu/view_road_states.hpp"
 #include "server/render/cpu/view_wet_fraction.hpp"
-#include "server/sim/glass_water_surface.hpp"
+#include "server/render/warm_up.hpp"
 
 namespace downpour::session {
 namespace {
@@ -153,20 +153,9 @@ void FrameScheduler::run(std::promise<void>* started) {
     readbacks_ = std::make_unique<render::ReadbackQueue<InFlight>>(
         *renderer_, [this](std::size_t bytes) { return encoders_.take_buffer(bytes); });
     // Warm-up: first frames prove the context, shaders and readback before we report ready, and
-    // have llvmpipe compile every pass's shaders (a drop and the blades on the glass) rather than
-    // a session's first frames.
-    sim::SceneState warm_scene;
-    sim::Simulation warm_sim(0, {});
-    warm_scene.windshield.metaballs.push_back({700.0f, 400.0f, 3.0f});
-    warm_scene.windshield.blades = warm_sim.state().windshield.blades;
-    warm_scene.windshield.surface =
-        sim::surface_from_metaballs(warm_scene.windshield.metaballs, warm_scene.glass);
-    for (const sim::View view : {sim::View::kCockpit, sim::View::kRoad, sim::View::kWindshield}) {
-      const std::vector<std::uint8_t> pixels =
-          render::render_image(*renderer_, sim::view_spec(view, 64, 36), warm_scene);
-      if (pixels.size() != 64u * 36u * 4u)
-        throw std::runtime_error("warm-up frame came back empty");
-    }
+    // have llvmpipe compile the shader variants the sessions' passes will pick rather than stall
+    // their streams (warm_up.hpp).
+    render::warm_up(*renderer_);
     {
       std::lock_guard lock(stats_mutex_);
       renderer_name_ = renderer_->gl_renderer() + " (EGL " + renderer_->platform() + ")";

@@ -447,4 +447,17 @@ Scenario city_drizzle() {
   return s;
 }
 
+Update behind_truck(const Scenario& scenario, double t, double gap_m) {
+  Update u = scenario.at(t);
+  if (!u.vehicle) return u;
+  const double speed = std::max(glm::length(u.vehicle->velocity_mps), 1.0);
+  TrafficVehicle truck;
+  truck.id = 1;
+  truck.state = scenario.at(t + gap_m / speed).vehicle.value_or(*u.vehicle);
+  truck.size_m = {12.0, 2.5, 3.8};
+  truck.vehicle_class = VehicleClass::kTruck;
+  u.traffic = std::vector<TrafficVehicle>{truck};
+  return u;
+}
+
 }  // namespace downpour::sim

@@ -38,6 +38,11 @@ struct Scenario {
   std::string samples_json(double step_s) const;
 };
 
+// The scenario's inputs at t with a truck `gap_m` ahead in the ego car's lane, 12 m long: the ego
+// car's own pose that much further on its drive (the spray behind it, for the benchmarks, the
+// renderer's warm-up and their tests).
+Update behind_truck(const Scenario& scenario, double t, double gap_m);
+
 // The standard scenes, defined once here and used by the benchmarks and the clients.
 Scenario highway_heavy_rain();
 Scenario city_drizzle();

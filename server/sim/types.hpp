@@ -66,7 +66,7 @@ struct TrafficVehicle {
   VehicleState state;
   glm::dvec3 size_m{4.5, 1.8, 1.5};
   VehicleClass vehicle_class = VehicleClass::kCar;
-  ModelPtr model;  // null: its class's built-in model
+  ModelPtr model{};  // null: its class's built-in model
 };
 
 // The road's state under a point (road_water.hpp).

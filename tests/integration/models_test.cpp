@@ -80,7 +80,9 @@ class ModelsTest : public ::testing::Test {
     ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
     v1::StepResponse resp;
     const grpc::Status s = stub->Step(&ctx, req, &resp);
-    if (s.ok()) EXPECT_EQ(resp.frames_size(), 2);
+    if (s.ok()) {
+      EXPECT_EQ(resp.frames_size(), 2);
+    }
     return s;
   }
 };

@@ -1,0 +1,113 @@
+#include "server/render/warm_up.hpp"
+
+#include <algorithm>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <vector>
+
+#include "server/render/renderer.hpp"
+#include "server/sim/glass_water_surface.hpp"
+#include "server/sim/scenario.hpp"
+#include "server/sim/simulation.hpp"
+
+namespace downpour::render {
+namespace {
+
+// Large enough that the road's near part (its relief) is drawn (at 160x90 it is not).
+constexpr int kWidth = 320, kHeight = 180;
+constexpr int kFrames = 2;  // a drive's later ticks drawn
+
+// Every view of a session, drawn as a session's tick draws them (begun, ended, read back), tick
+// after tick (the environment's faces and the layers' copies are drawn in turn from the second
+// on).
+class Session {
+ public:
+  explicit Session(Renderer& renderer) : renderer_(renderer), session_(renderer.open_session()) {
+    for (int v = 0; v < sim::kViewCount; ++v)
+      views_.push_back(sim::view_spec(static_cast<sim::View>(v), kWidth, kHeight));
+  }
+  // `ticks` ticks of the first `views` views (all by default).
+  void draw(const std::function<const sim::SceneState&()>& next, int ticks, int views = -1) {
+    const std::size_t drawn = views < 0 ? views_.size() : static_cast<std::size_t>(views);
+    for (int f = 0; f < ticks; ++f) {
+      const sim::SceneState& scene = next();
+      const StepSource stepped = [&]() -> const sim::SceneState& { return scene; };
+      std::vector<std::unique_ptr<Renderer::ViewFrame>> begun;
+      for (std::size_t v = 0; v < drawn; ++v)
+        begun.push_back(renderer_.begin(*session_, static_cast<int>(v), views_[v], scene, stepped));
+      std::vector<PendingReadback> pending;
+      for (auto& frame : begun) pending.push_back(renderer_.end(*frame));
+      for (const PendingReadback& p : pending) {
+        renderer_.finish(p, pixels_);
+        if (pixels_.size() != static_cast<std::size_t>(kWidth) * kHeight * 4)
+          throw std::runtime_error("warm-up frame came back empty");
+      }
+    }
+  }
+
+ private:
+  Renderer& renderer_;
+  std::unique_ptr<RenderSession> session_;
+  std::vector<sim::ViewSpec> views_;
+  std::vector<std::uint8_t> pixels_;
+};
+
+// The heavy-rain drive with 3 mm standing on the road (a film, puddles in its hollows) behind a
+// truck 22 m ahead in the lane, under `weather`, in a session of its own: its first ticks (dry
+// glass: the environment drawn whole, then its first face on its own at the seventh), then, if
+// `later_s` > 0, a few from then on (drops on the glass, spray behind the truck and the ego car's
+// tires).
+void draw_wet_drive(Renderer& renderer, const sim::Weather& weather, double later_s) {
+  const sim::Scenario scenario = sim::highway_heavy_rain();
+  sim::SimulationConfig config;
+  config.road.initial_m = 0.003;
+  auto update = [&](double t) {
+    sim::Update u = sim::behind_truck(scenario, t, 22.0);
+    u.weather = weather;
+    return u;
+  };
+  sim::Simulation simulation(scenario.seed, update(0.0), config);
+  const double dt = 1.0 / scenario.fps;
+  double t = 0.0;
+  auto tick = [&]() -> const sim::SceneState& {
+    t += dt;
+    simulation.apply(update(t));
+    simulation.advance(dt);
+    return simulation.state();
+  };
+  // The driver's view by itself, its environment drawn whole (every face with the world in it).
+  renderer.render_image(sim::view_spec(sim::View::kCockpit, kWidth, kHeight), tick());
+  // A session's first tick, then its seventh, which draws a face on its own (the driver's view
+  // alone between them: a tick's first view brings the environment up to date).
+  Session session(renderer);
+  session.draw(tick, 1);
+  session.draw(tick, 6, 1);
+  if (later_s <= 0.0) return;
+  while (t < later_s - 1e-9) tick();
+  session.draw(tick, kFrames);
+}
+
+}  // namespace
+
+void warm_up(Renderer& renderer) {
+  // A drop and the blades on dry glass.
+  sim::SceneState parked_scene;
+  sim::Simulation parked(0, {});
+  parked_scene.windshield.metaballs.push_back({700.0f, 400.0f, 3.0f});
+  parked_scene.windshield.blades = parked.state().windshield.blades;
+  parked_scene.windshield.surface =
+      sim::surface_from_metaballs(parked_scene.windshield.metaballs, parked_scene.glass);
+  Session(renderer).draw([&]() -> const sim::SceneState& { return parked_scene; }, 2);
+  const sim::Weather rain = sim::highway_heavy_rain().at(0.0).weather.value_or(sim::Weather{});
+  draw_wet_drive(renderer, rain, 1.0);
+  sim::Weather night = rain;  // the lamps
+  night.sun_altitude_deg = -20.0;
+  draw_wet_drive(renderer, night, 1.0);
+  sim::Weather low_sun = rain;  // the relief's shadows
+  low_sun.cloudiness = 0.0;
+  low_sun.sun_altitude_deg = 10.0;
+  draw_wet_drive(renderer, low_sun, 0.0);
+}
+
+}  // namespace downpour::render

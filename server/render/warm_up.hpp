@@ -1,0 +1,20 @@
+// Before a server takes sessions: every program and state the views' passes may pick drawn once,
+// small, so that llvmpipe compiles its shader variants then and not in a session's stream. A
+// variant first needed mid-stream stalls the render loop, and with it every session, for the
+// compile (100-250 ms each on the development machine, without Mesa's shader cache on disk: a
+// fresh machine's first run, a container's every start): spray behind a truck, puddles with their
+// mirror and ripples, the lamps at night, the relief shadows under the sun.
+#pragma once
+
+namespace downpour::render {
+
+class Renderer;
+
+// Draws the built-in scenes in every view at 320x180, as sessions do: a drop on dry glass; heavy
+// rain with water standing on the road behind a truck, by day, at night and under a low sun, each
+// from a session's start (the environment probe drawn whole, then a face on its own) and, by day
+// and at night, a second on (drops, spray). 1.3-1.4 s on the development machine with Mesa's
+// shader cache on disk, 6 s without. Throws std::runtime_error if a frame comes back empty.
+void warm_up(Renderer& renderer);
+
+}  // namespace downpour::render
