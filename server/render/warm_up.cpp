@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "server/render/renderer.hpp"
@@ -23,9 +25,13 @@ constexpr int kFrames = 2;  // a drive's later ticks drawn
 // on).
 class Session {
  public:
-  explicit Session(Renderer& renderer) : renderer_(renderer), session_(renderer.open_session()) {
+  explicit Session(Renderer& renderer, std::vector<sim::ViewSpec> views = every_view())
+      : renderer_(renderer), session_(renderer.open_session()), views_(std::move(views)) {}
+  static std::vector<sim::ViewSpec> every_view() {
+    std::vector<sim::ViewSpec> views;
     for (int v = 0; v < sim::kViewCount; ++v)
-      views_.push_back(sim::view_spec(static_cast<sim::View>(v), kWidth, kHeight));
+      views.push_back(sim::view_spec(static_cast<sim::View>(v), kWidth, kHeight));
+    return views;
   }
   // `ticks` ticks of the first `views` views (all by default).
   void draw(const std::function<const sim::SceneState&()>& next, int ticks, int views = -1) {
@@ -39,7 +45,7 @@ class Session {
       std::vector<PendingReadback> pending;
       for (auto& frame : begun) pending.push_back(renderer_.end(*frame));
       for (const PendingReadback& p : pending) {
-        renderer_.finish(p, pixels_);
+        renderer_.finish(p, pixels_, &truth_);
         if (pixels_.size() != static_cast<std::size_t>(kWidth) * kHeight * 4)
           throw std::runtime_error("warm-up frame came back empty");
       }
@@ -51,7 +57,22 @@ class Session {
   std::unique_ptr<RenderSession> session_;
   std::vector<sim::ViewSpec> views_;
   std::vector<std::uint8_t> pixels_;
+  GroundTruthPixels truth_;
 };
+
+// A client's picture for the views over one: a flat grey, 30 m away where `depth` (else none).
+std::shared_ptr<const sim::ClientImage> picture(bool depth) {
+  auto image = std::make_shared<sim::ClientImage>();
+  image->width = kWidth;
+  image->height = kHeight;
+  image->bgrx.assign(static_cast<std::size_t>(kWidth) * kHeight * 4, 128);
+  if (depth) image->depth_m.assign(static_cast<std::size_t>(kWidth) * kHeight, 30.0f);
+  // Serials no client's picture takes (theirs count up from 1, rpc/validation.cpp): a pass that
+  // keeps what it made of a picture by its serial must not take a session's first pictures for
+  // these.
+  image->serial = std::numeric_limits<std::uint64_t>::max() - (depth ? 0 : 1);
+  return image;
+}
 
 // The heavy-rain drive with 3 mm standing on the road (a film, puddles in its hollows) behind a
 // truck 22 m ahead in the lane, under `weather`, in a session of its own: its first ticks (dry
@@ -86,6 +107,30 @@ void draw_wet_drive(Renderer& renderer, const sim::Weather& weather, double late
   if (later_s <= 0.0) return;
   while (t < later_s - 1e-9) tick();
   session.draw(tick, kFrames);
+  // The views that take a client's picture over one, with its depth and the server's haze, and
+  // without, each with its clean frame and water mask. (The outputs of the views of the server's
+  // world need no variants of their own: the test draws them.)
+  for (const bool depth : {true, false}) {
+    std::vector<sim::ViewSpec> over;
+    sim::ClientImages pictures{};
+    for (const sim::View v : {sim::View::kCockpit, sim::View::kRoad, sim::View::kWindshield}) {
+      sim::ViewSpec spec = sim::view_spec(v, kWidth, kHeight);
+      spec.background = sim::Background::kClient;
+      spec.haze = depth;
+      spec.outputs.clean = spec.outputs.water_mask = true;
+      over.push_back(spec);
+      pictures[static_cast<std::size_t>(v)] = picture(depth);
+    }
+    sim::SceneState scene;
+    Session(renderer, over)
+        .draw(
+            [&]() -> const sim::SceneState& {
+              scene = tick();
+              scene.client_images = pictures;
+              return scene;
+            },
+            kFrames);
+  }
 }
 
 }  // namespace

@@ -13,8 +13,9 @@ class Renderer;
 // Draws the built-in scenes in every view at 320x180, as sessions do: a drop on dry glass; heavy
 // rain with water standing on the road behind a truck, by day, at night and under a low sun, each
 // from a session's start (the environment probe drawn whole, then a face on its own) and, by day
-// and at night, a second on (drops, spray). 1.3-1.4 s on the development machine with Mesa's
-// shader cache on disk, 6 s without. Throws std::runtime_error if a frame comes back empty.
+// and at night, a second on (drops, spray), then over a client's pictures with and without their
+// depth. 1.3-1.9 s on the development machine with Mesa's shader cache on disk, 6 s without.
+// Throws std::runtime_error if a frame comes back empty.
 void warm_up(Renderer& renderer);
 
 }  // namespace downpour::render

@@ -29,6 +29,8 @@ struct Drive {
   bool truck = false;
   double road_water_m = 0.0;
   double seconds = 2.0;
+  std::vector<sim::ViewSpec> views;  // none: COCKPIT and ROAD
+  sim::ClientImages pictures{};      // the client's pictures in every tick's scene
 };
 
 class RenderAllocationsTest : public RenderTest {
@@ -49,20 +51,23 @@ class RenderAllocationsTest : public RenderTest {
       return u;
     };
     sim::Simulation simulation(scenario.seed, update(0.0), config);
-    const std::vector<sim::ViewSpec> views{view_spec(sim::View::kCockpit, 320, 180),
-                                           view_spec(sim::View::kRoad, 320, 180)};
+    const std::vector<sim::ViewSpec> views =
+        !d.views.empty() ? d.views
+                         : std::vector<sim::ViewSpec>{view_spec(sim::View::kCockpit, 320, 180),
+                                                      view_spec(sim::View::kRoad, 320, 180)};
     std::unique_ptr<render::RenderSession> session = renderer().open_session();
     std::vector<std::vector<std::uint8_t>> pixels(views.size());
-    const render::StepSource stepped = [&]() -> const sim::SceneState& {
-      return simulation.state();
-    };
+    render::GroundTruthPixels truth;
+    sim::SceneState scene;
+    const render::StepSource stepped = [&]() -> const sim::SceneState& { return scene; };
     const double dt = 1.0 / scenario.fps;
     std::vector<Tick> ticks;
     const int count = static_cast<int>(d.seconds * scenario.fps);
     for (int i = 0; i < count; ++i) {
       simulation.apply(update((i + 1) * dt));
       simulation.advance(dt);
-      const sim::SceneState& scene = simulation.state();
+      scene = simulation.state();
+      scene.client_images = d.pictures;
       const auto t0 = std::chrono::steady_clock::now();
       if (i >= counted_from_tick) start_counting_allocations();
       std::vector<std::unique_ptr<render::Renderer::ViewFrame>> begun;
@@ -70,7 +75,8 @@ class RenderAllocationsTest : public RenderTest {
         begun.push_back(renderer().begin(*session, static_cast<int>(v), views[v], scene, stepped));
       std::vector<render::PendingReadback> pending;
       for (auto& frame : begun) pending.push_back(renderer().end(*frame));
-      for (std::size_t v = 0; v < views.size(); ++v) renderer().finish(pending[v], pixels[v]);
+      for (std::size_t v = 0; v < views.size(); ++v)
+        renderer().finish(pending[v], pixels[v], &truth);
       if (i < counted_from_tick) continue;
       ticks.push_back({stop_counting_allocations(), std::chrono::duration<double, std::milli>(
                                                         std::chrono::steady_clock::now() - t0)
@@ -102,9 +108,10 @@ class RenderWarmUpTest : public RenderAllocationsTest {};
 // With Mesa's shader cache on disk off (the test's ctest entry, render_warm_up, sets
 // MESA_SHADER_CACHE_DISABLE, as on a fresh machine or in a new container), the warm-up, then
 // sessions that need its variants: heavy rain behind a truck on a flooded road by day (the demo's
-// weather), under a low sun in a clear sky, and at night. No tick compiles. (Not yet covered: at
-// night a session's 43rd tick, the first to draw the environment's sky face on its own, compiles
-// one more variant, 130-160 ms; the night's drive stops before it.)
+// weather), under a low sun in a clear sky, at night, over a client's pictures, and with every
+// output. No tick compiles. (Not yet covered: at night a session's 43rd tick, the first to draw
+// the environment's sky face on its own, compiles one more variant, 130-160 ms; the night's drive
+// stops before it.)
 TEST_F(RenderWarmUpTest, AfterItNoTickCompilesAShader) {
   const auto w0 = std::chrono::steady_clock::now();
   render::warm_up(renderer());
@@ -115,14 +122,45 @@ TEST_F(RenderWarmUpTest, AfterItNoTickCompilesAShader) {
   night.sun_altitude_deg = -20.0;
   low_sun.cloudiness = 0.0;
   low_sun.sun_altitude_deg = 10.0;
-  for (const auto& [name, weather, seconds] : {std::tuple{"rain", Drive{}.weather, 2.0},
-                                               {"low sun", low_sun, 2.0},
-                                               {"night", night, 1.3}}) {
+  // Over a client's pictures with their depth and the server's haze, each view with its clean
+  // frame and water mask; the server's world with every output.
+  std::vector<sim::ViewSpec> over, outputs;
+  sim::ClientImages pictures{};
+  auto picture = std::make_shared<sim::ClientImage>();
+  picture->width = 320;
+  picture->height = 180;
+  picture->bgrx.assign(320 * 180 * 4, 100);
+  picture->depth_m.assign(320 * 180, 25.0f);
+  picture->serial = 7;
+  for (const sim::View v : {sim::View::kCockpit, sim::View::kRoad}) {
+    sim::ViewSpec spec = view_spec(v, 320, 180);
+    spec.outputs = {true, true, true};
+    outputs.push_back(spec);
+    spec.background = sim::Background::kClient;
+    spec.haze = true;
+    spec.outputs.depth = false;
+    over.push_back(spec);
+    pictures[static_cast<std::size_t>(v)] = picture;
+  }
+  struct Case {
+    const char* name;
+    sim::Weather weather;
+    double seconds;
+    std::vector<sim::ViewSpec> views;
+    sim::ClientImages pictures{};
+  };
+  for (const Case& c :
+       {Case{"rain", Drive{}.weather, 2.0, {}}, Case{"low sun", low_sun, 2.0, {}},
+        Case{"night", night, 1.3, {}}, Case{"pictures", Drive{}.weather, 1.3, over, pictures},
+        Case{"outputs", Drive{}.weather, 1.3, outputs}}) {
+    const char* name = c.name;
     Drive d;
-    d.weather = weather;
+    d.weather = c.weather;
     d.truck = true;
     d.road_water_m = 0.003;
-    d.seconds = seconds;
+    d.seconds = c.seconds;
+    d.views = c.views;
+    d.pictures = c.pictures;
     int tick = 0;
     for (const Tick& t : drive(d, 0)) {
       if (std::getenv("DOWNPOUR_PRINT_TICKS"))
