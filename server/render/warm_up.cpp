@@ -60,8 +60,8 @@ class Session {
   GroundTruthPixels truth_;
 };
 
-// A client's picture for the views over one: a flat grey, 30 m away where `depth` (else none).
-std::shared_ptr<const sim::ClientImage> picture(bool depth) {
+// A client's picture for view v over one: a flat grey, 30 m away where `depth` (else none).
+std::shared_ptr<const sim::ClientImage> picture(sim::View v, bool depth) {
   auto image = std::make_shared<sim::ClientImage>();
   image->width = kWidth;
   image->height = kHeight;
@@ -70,7 +70,8 @@ std::shared_ptr<const sim::ClientImage> picture(bool depth) {
   // Serials no client's picture takes (theirs count up from 1, rpc/validation.cpp): a pass that
   // keeps what it made of a picture by its serial must not take a session's first pictures for
   // these.
-  image->serial = std::numeric_limits<std::uint64_t>::max() - (depth ? 0 : 1);
+  image->serial = std::numeric_limits<std::uint64_t>::max() - 2 * static_cast<std::uint64_t>(v) -
+                  (depth ? 0 : 1);
   return image;
 }
 
@@ -98,7 +99,9 @@ void draw_wet_drive(Renderer& renderer, const sim::Weather& weather, double late
     return simulation.state();
   };
   // The driver's view by itself, its environment drawn whole (every face with the world in it).
-  renderer.render_image(sim::view_spec(sim::View::kCockpit, kWidth, kHeight), tick());
+  if (renderer.render_image(sim::view_spec(sim::View::kCockpit, kWidth, kHeight), tick()).size() !=
+      static_cast<std::size_t>(kWidth) * kHeight * 4)
+    throw std::runtime_error("warm-up frame came back empty");
   // A session's first tick, then its seventh, which draws a face on its own (the driver's view
   // alone between them: a tick's first view brings the environment up to date).
   Session session(renderer);
@@ -119,7 +122,7 @@ void draw_wet_drive(Renderer& renderer, const sim::Weather& weather, double late
       spec.haze = depth;
       spec.outputs.clean = spec.outputs.water_mask = true;
       over.push_back(spec);
-      pictures[static_cast<std::size_t>(v)] = picture(depth);
+      pictures[static_cast<std::size_t>(v)] = picture(v, depth);
     }
     sim::SceneState scene;
     Session(renderer, over)

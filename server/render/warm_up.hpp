@@ -1,5 +1,6 @@
-// Before a server takes sessions: every program and state the views' passes may pick drawn once,
-// small, so that llvmpipe compiles its shader variants then and not in a session's stream. A
+// Before a server takes sessions: the programs and states the views' passes pick in the common
+// scenes drawn once, small, so that llvmpipe compiles their shader variants then and not in a
+// session's stream (what is still left: docs/operations.md). A
 // variant first needed mid-stream stalls the render loop, and with it every session, for the
 // compile (100-250 ms each on the development machine, without Mesa's shader cache on disk: a
 // fresh machine's first run, a container's every start): spray behind a truck, puddles with their

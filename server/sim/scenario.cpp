@@ -454,7 +454,7 @@ Update behind_truck(const Scenario& scenario, double t, double gap_m) {
   TrafficVehicle truck;
   truck.id = 1;
   truck.state = scenario.at(t + gap_m / speed).vehicle.value_or(*u.vehicle);
-  truck.size_m = {12.0, 2.5, 3.8};
+  truck.size_m = kBehindTruckSize_m;
   truck.vehicle_class = VehicleClass::kTruck;
   u.traffic = std::vector<TrafficVehicle>{truck};
   return u;

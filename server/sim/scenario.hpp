@@ -42,6 +42,7 @@ struct Scenario {
 // car's own pose that much further on its drive (the spray behind it, for the benchmarks, the
 // renderer's warm-up and their tests).
 Update behind_truck(const Scenario& scenario, double t, double gap_m);
+inline const glm::dvec3 kBehindTruckSize_m{12.0, 2.5, 3.8};  // its length, width and height
 
 // The standard scenes, defined once here and used by the benchmarks and the clients.
 Scenario highway_heavy_rain();

@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"
 #include "server/sim/track.hpp"
 
@@ -25,7 +26,7 @@ inline sim::VehicleState on_track(double s, double speed, int lane = 0) {
   return v;
 }
 
-inline const glm::dvec3 kTruckSize(12.0, 2.5, 3.8);
+inline const glm::dvec3 kTruckSize = sim::kBehindTruckSize_m;
 
 struct SprayDrive {
   double start_s = 400.0;
