@@ -36,20 +36,8 @@ class Session {
   // `ticks` ticks of the first `views` views (all by default).
   void draw(const std::function<const sim::SceneState&()>& next, int ticks, int views = -1) {
     const std::size_t drawn = views < 0 ? views_.size() : static_cast<std::size_t>(views);
-    for (int f = 0; f < ticks; ++f) {
-      const sim::SceneState& scene = next();
-      const StepSource stepped = [&]() -> const sim::SceneState& { return scene; };
-      std::vector<std::unique_ptr<Renderer::ViewFrame>> begun;
-      for (std::size_t v = 0; v < drawn; ++v)
-        begun.push_back(renderer_.begin(*session_, static_cast<int>(v), views_[v], scene, stepped));
-      std::vector<PendingReadback> pending;
-      for (auto& frame : begun) pending.push_back(renderer_.end(*frame));
-      for (const PendingReadback& p : pending) {
-        renderer_.finish(p, pixels_, &truth_);
-        if (pixels_.size() != static_cast<std::size_t>(kWidth) * kHeight * 4)
-          throw std::runtime_error("warm-up frame came back empty");
-      }
-    }
+    for (int f = 0; f < ticks; ++f)
+      draw_tick(renderer_, *session_, views_, drawn, next(), pixels_, truth_);
   }
 
  private:
@@ -137,6 +125,22 @@ void draw_wet_drive(Renderer& renderer, const sim::Weather& weather, double late
 }
 
 }  // namespace
+
+void draw_tick(Renderer& renderer, RenderSession& session, const std::vector<sim::ViewSpec>& views,
+               std::size_t count, const sim::SceneState& scene, std::vector<std::uint8_t>& pixels,
+               GroundTruthPixels& truth) {
+  const StepSource stepped = [&]() -> const sim::SceneState& { return scene; };
+  std::vector<std::unique_ptr<Renderer::ViewFrame>> begun;
+  for (std::size_t v = 0; v < count; ++v)
+    begun.push_back(renderer.begin(session, static_cast<int>(v), views[v], scene, stepped));
+  std::vector<PendingReadback> pending;
+  for (auto& frame : begun) pending.push_back(renderer.end(*frame));
+  for (std::size_t v = 0; v < count; ++v) {
+    renderer.finish(pending[v], pixels, &truth);
+    if (pixels.size() != static_cast<std::size_t>(views[v].width) * views[v].height * 4)
+      throw std::runtime_error("a frame came back the wrong size");
+  }
+}
 
 void warm_up(Renderer& renderer) {
   // A drop and the blades on dry glass.

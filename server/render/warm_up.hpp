@@ -7,9 +7,19 @@
 // mirror and ripples, the lamps at night, the relief shadows under the sun.
 #pragma once
 
+#include <cstdint>
+#include <vector>
+
+#include "server/render/renderer.hpp"
+
 namespace downpour::render {
 
-class Renderer;
+// One tick of the first `count` of a session's `views`, as a session's tick draws them: each
+// begun, then each ended, then each read back (into `pixels` and `truth`, in turn). Throws
+// std::runtime_error if a frame comes back the wrong size. (The warm-up's and its tests'.)
+void draw_tick(Renderer& renderer, RenderSession& session, const std::vector<sim::ViewSpec>& views,
+               std::size_t count, const sim::SceneState& scene, std::vector<std::uint8_t>& pixels,
+               GroundTruthPixels& truth);
 
 // Draws the built-in scenes in every view at 320x180, as sessions do: a drop on dry glass; heavy
 // rain with water standing on the road behind a truck, by day, at night and under a low sun, each

@@ -56,10 +56,9 @@ class RenderAllocationsTest : public RenderTest {
                          : std::vector<sim::ViewSpec>{view_spec(sim::View::kCockpit, 320, 180),
                                                       view_spec(sim::View::kRoad, 320, 180)};
     std::unique_ptr<render::RenderSession> session = renderer().open_session();
-    std::vector<std::vector<std::uint8_t>> pixels(views.size());
+    std::vector<std::uint8_t> pixels;
     render::GroundTruthPixels truth;
     sim::SceneState scene;
-    const render::StepSource stepped = [&]() -> const sim::SceneState& { return scene; };
     const double dt = 1.0 / scenario.fps;
     std::vector<Tick> ticks;
     const int count = static_cast<int>(d.seconds * scenario.fps);
@@ -70,13 +69,7 @@ class RenderAllocationsTest : public RenderTest {
       scene.client_images = d.pictures;
       const auto t0 = std::chrono::steady_clock::now();
       if (i >= counted_from_tick) start_counting_allocations();
-      std::vector<std::unique_ptr<render::Renderer::ViewFrame>> begun;
-      for (std::size_t v = 0; v < views.size(); ++v)
-        begun.push_back(renderer().begin(*session, static_cast<int>(v), views[v], scene, stepped));
-      std::vector<render::PendingReadback> pending;
-      for (auto& frame : begun) pending.push_back(renderer().end(*frame));
-      for (std::size_t v = 0; v < views.size(); ++v)
-        renderer().finish(pending[v], pixels[v], &truth);
+      render::draw_tick(renderer(), *session, views, views.size(), scene, pixels, truth);
       if (i < counted_from_tick) continue;
       ticks.push_back({stop_counting_allocations(), std::chrono::duration<double, std::milli>(
                                                         std::chrono::steady_clock::now() - t0)
