@@ -139,6 +139,7 @@ session::SchedulerOptions scheduler_options(const ServerConfig& config,
   options.observer = std::move(metrics);
   options.renderer.platform = config.renderer;
   options.renderer.spray_smoothing = config.spray_smoothing;
+  options.warm_up = config.warm_up;
   options.encoder_threads = config.encoder_threads;
   return options;
 }

@@ -73,6 +73,7 @@ void add_serving_options(CLI::App& app, ServerConfig& c) {
 struct NamedChoices {
   std::string renderer = "auto";
   std::string smoothing = "plane_fit";
+  std::string warm_up = "full";
 };
 
 void add_choice_options(CLI::App& app, NamedChoices& choices) {
@@ -86,6 +87,12 @@ void add_choice_options(CLI::App& app, NamedChoices& choices) {
                  "passes) or none")
       ->check(CLI::IsMember({"plane_fit", "bilateral", "none"}, CLI::ignore_case))
       ->envname("DOWNPOUR_SPRAY_SMOOTHING");
+  app.add_option("--warm-up", choices.warm_up,
+                 "before serving: full draws the common scenes small so that llvmpipe compiles "
+                 "their shaders then, not in a session's stream (2 s; 6 s without Mesa's shader "
+                 "cache); minimal proves the context with one tiny frame (tests of the protocol)")
+      ->check(CLI::IsMember({"full", "minimal"}, CLI::ignore_case))
+      ->envname("DOWNPOUR_WARM_UP");
 }
 
 // The parsed choices' names (any case) into their values.
@@ -98,12 +105,13 @@ void apply_choices(NamedChoices choices, ServerConfig& c) {
       {"plane_fit", render::SpraySmoothing::kPlaneFit},
       {"bilateral", render::SpraySmoothing::kBilateral},
       {"none", render::SpraySmoothing::kNone}};
-  std::string& renderer = choices.renderer;
-  std::string& smoothing = choices.smoothing;
-  std::transform(renderer.begin(), renderer.end(), renderer.begin(), ::tolower);
-  std::transform(smoothing.begin(), smoothing.end(), smoothing.begin(), ::tolower);
-  c.renderer = renderers.at(renderer);
-  c.spray_smoothing = smoothings.at(smoothing);
+  const std::map<std::string, render::WarmUp> warm_ups{{"full", render::WarmUp::kFull},
+                                                       {"minimal", render::WarmUp::kMinimal}};
+  for (std::string* name : {&choices.renderer, &choices.smoothing, &choices.warm_up})
+    std::transform(name->begin(), name->end(), name->begin(), ::tolower);
+  c.renderer = renderers.at(choices.renderer);
+  c.spray_smoothing = smoothings.at(choices.smoothing);
+  c.warm_up = warm_ups.at(choices.warm_up);
 }
 
 // The options of running it: its log, the sessions' idle timeout, the drain's grace, the

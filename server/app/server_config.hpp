@@ -10,6 +10,7 @@
 
 #include "server/render/cpu/spray_smoothing.hpp"
 #include "server/render/gl/egl_context.hpp"
+#include "server/render/warm_up.hpp"
 #include "server/session/admission.hpp"
 
 namespace downpour::app {
@@ -28,6 +29,7 @@ struct ServerConfig {
   int render_threads = 0;  // LP_NUM_THREADS for llvmpipe; 0 = as set, else the cores + 1
   render::EglPlatformChoice renderer = render::EglPlatformChoice::kAuto;
   render::SpraySmoothing spray_smoothing = render::SpraySmoothing::kPlaneFit;
+  render::WarmUp warm_up = render::WarmUp::kFull;
   std::string log_level = "info";
   std::string log_format = "text";  // or "json" (app/log_format.hpp)
   double stats_interval_s = 30.0;

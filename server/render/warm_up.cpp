@@ -18,7 +18,15 @@ namespace {
 
 // Large enough that the road's near part (its relief) is drawn (at 160x90 it is not).
 constexpr int kWidth = 320, kHeight = 180;
+constexpr int kMinimalWidth = 64, kMinimalHeight = 36;
 constexpr int kFrames = 2;  // a drive's later ticks drawn
+
+std::vector<sim::ViewSpec> every_view(int width = kWidth, int height = kHeight) {
+  std::vector<sim::ViewSpec> views;
+  for (int v = 0; v < sim::kViewCount; ++v)
+    views.push_back(sim::view_spec(static_cast<sim::View>(v), width, height));
+  return views;
+}
 
 // Every view of a session, drawn as a session's tick draws them (begun, ended, read back), tick
 // after tick (the environment's faces and the layers' copies are drawn in turn from the second
@@ -27,12 +35,6 @@ class Session {
  public:
   explicit Session(Renderer& renderer, std::vector<sim::ViewSpec> views = every_view())
       : renderer_(renderer), session_(renderer.open_session()), views_(std::move(views)) {}
-  static std::vector<sim::ViewSpec> every_view() {
-    std::vector<sim::ViewSpec> views;
-    for (int v = 0; v < sim::kViewCount; ++v)
-      views.push_back(sim::view_spec(static_cast<sim::View>(v), kWidth, kHeight));
-    return views;
-  }
   // `ticks` ticks of the first `views` views (all by default).
   void draw(const std::function<const sim::SceneState&()>& next, int ticks, int views = -1) {
     const std::size_t drawn = views < 0 ? views_.size() : static_cast<std::size_t>(views);
@@ -142,7 +144,7 @@ void draw_tick(Renderer& renderer, RenderSession& session, const std::vector<sim
   }
 }
 
-void warm_up(Renderer& renderer) {
+void warm_up(Renderer& renderer, WarmUp level) {
   // A drop and the blades on dry glass.
   sim::SceneState parked_scene;
   sim::Simulation parked(0, {});
@@ -150,7 +152,12 @@ void warm_up(Renderer& renderer) {
   parked_scene.windshield.blades = parked.state().windshield.blades;
   parked_scene.windshield.surface =
       sim::surface_from_metaballs(parked_scene.windshield.metaballs, parked_scene.glass);
-  Session(renderer).draw([&]() -> const sim::SceneState& { return parked_scene; }, 2);
+  auto parked_tick = [&]() -> const sim::SceneState& { return parked_scene; };
+  if (level == WarmUp::kMinimal) {
+    Session(renderer, every_view(kMinimalWidth, kMinimalHeight)).draw(parked_tick, 1);
+    return;
+  }
+  Session(renderer).draw(parked_tick, 2);
   const sim::Weather rain = sim::highway_heavy_rain().at(0.0).weather.value_or(sim::Weather{});
   draw_wet_drive(renderer, rain, 1.0);
   sim::Weather night = rain;  // the lamps

@@ -10,9 +10,16 @@
 #include <cstdint>
 #include <vector>
 
-#include "server/render/renderer.hpp"
+namespace downpour::sim {
+struct SceneState;
+struct ViewSpec;
+}  // namespace downpour::sim
 
 namespace downpour::render {
+
+class Renderer;
+class RenderSession;
+struct GroundTruthPixels;
 
 // One tick of the first `count` of a session's `views`, as a session's tick draws them: each
 // begun, then each ended, then each read back (into `pixels` and `truth`, in turn). Throws
@@ -21,12 +28,23 @@ void draw_tick(Renderer& renderer, RenderSession& session, const std::vector<sim
                std::size_t count, const sim::SceneState& scene, std::vector<std::uint8_t>& pixels,
                GroundTruthPixels& truth);
 
-// Draws the built-in scenes in every view at 320x180, as sessions do: a drop on dry glass; heavy
-// rain with water standing on the road behind a truck, by day, at night and under a low sun, each
-// from a session's start (the environment probe drawn whole, then a face on its own) and, by day
-// and at night, a second on (drops, spray), then over a client's pictures with and without their
-// depth. 1.3-1.9 s on the development machine with Mesa's shader cache on disk, 6 s without.
-// Throws std::runtime_error if a frame comes back empty.
-void warm_up(Renderer& renderer);
+// How much the warm-up draws (the server's --warm-up).
+enum class WarmUp {
+  // The built-in scenes in every view at 320x180, as sessions draw them: a drop on dry glass;
+  // heavy rain with water standing on the road behind a truck, by day, at night and under a low
+  // sun, each from a session's start (the environment probe drawn whole, then a face on its own)
+  // and, by day and at night, a second on (drops, spray), then over a client's pictures with and
+  // without their depth. 1.5-2 s on the development machine with Mesa's shader cache on disk
+  // (5-6 s under ASan), 6 s without.
+  kFull,
+  // A drop on dry glass in every view at 64x36: proves the context, the programs and the
+  // readback, and leaves the variants the sessions' scenes pick to be compiled when first drawn
+  // (for servers whose streams are not watched for stalls: the tests of the protocol).
+  kMinimal,
+};
+
+// Draws what `level` says. Throws std::runtime_error if a frame comes back empty or the wrong
+// size.
+void warm_up(Renderer& renderer, WarmUp level = WarmUp::kFull);
 
 }  // namespace downpour::render

@@ -155,7 +155,11 @@ void FrameScheduler::run(std::promise<void>* started) {
     // Warm-up: first frames prove the context, shaders and readback before we report ready, and
     // have llvmpipe compile the shader variants the sessions' passes will pick rather than stall
     // their streams (warm_up.hpp).
-    render::warm_up(*renderer_);
+    const auto warm_up_start = Clock::now();
+    render::warm_up(*renderer_, options_.warm_up);
+    spdlog::info("renderer warmed up ({}) in {:.1f} s",
+                 options_.warm_up == render::WarmUp::kFull ? "full" : "minimal",
+                 std::chrono::duration<double>(Clock::now() - warm_up_start).count());
     {
       std::lock_guard lock(stats_mutex_);
       renderer_name_ = renderer_->gl_renderer() + " (EGL " + renderer_->platform() + ")";

@@ -23,6 +23,7 @@
 #include "server/encode/encoder_pool.hpp"
 #include "server/render/readback_queue.hpp"
 #include "server/render/renderer.hpp"
+#include "server/render/warm_up.hpp"
 #include "server/session/session_registry.hpp"
 #include "server/session/tick_policy.hpp"
 #include "server/sim/worker_thread.hpp"
@@ -42,8 +43,9 @@ class FrameObserver {
 struct SchedulerOptions {
   render::RendererOptions renderer;
   int encoder_threads = 1;
-  bool profile_passes = false;              // glFinish after each pass (benchmarks)
-  std::shared_ptr<FrameObserver> observer;  // may be null
+  bool profile_passes = false;                     // glFinish after each pass (benchmarks)
+  render::WarmUp warm_up = render::WarmUp::kFull;  // before the loop serves (warm_up.hpp)
+  std::shared_ptr<FrameObserver> observer;         // may be null
 };
 
 struct SchedulerStats {

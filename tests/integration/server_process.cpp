@@ -47,6 +47,13 @@ ServerProcess::ServerProcess(std::vector<std::string> extra_args) {
     args.push_back("--listen");
     args.push_back("127.0.0.1:0");
   }
+  // The smallest warm-up, unless the test asks (warm_up.hpp): the full one takes 2 s a start
+  // (5-6 under ASan), and only the streams of a test that times them mind a shader compiled in
+  // their first ticks.
+  if (std::find(extra_args.begin(), extra_args.end(), "--warm-up") == extra_args.end()) {
+    args.push_back("--warm-up");
+    args.push_back("minimal");
+  }
   args.insert(args.end(), extra_args.begin(), extra_args.end());
   pid_ = fork();
   if (pid_ == 0) {

@@ -21,6 +21,7 @@ int free_port();
 
 class ServerProcess {
  public:
+  // With the minimal warm-up unless extra_args name --warm-up.
   explicit ServerProcess(std::vector<std::string> extra_args = {});
   ~ServerProcess();
 

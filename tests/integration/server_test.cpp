@@ -27,12 +27,13 @@ namespace {
 
 using v1::Downpour;
 
-// One server for the whole file; each test makes its own sessions and closes them.
+// One server for the whole file; each test makes its own sessions and closes them. Warmed up as a
+// deployed server is: its tests time streams (a stalled reader must not slow another session).
 ServerProcess* g_server = nullptr;
 
 class ServerEnvironment : public ::testing::Environment {
  public:
-  void SetUp() override { g_server = new ServerProcess(); }
+  void SetUp() override { g_server = new ServerProcess({"--warm-up", "full"}); }
   void TearDown() override {
     // SIGTERM drains and exits cleanly, promptly.
     const auto t0 = std::chrono::steady_clock::now();

@@ -36,8 +36,9 @@ def terminate(process, timeout_s=15):
 
 
 class ServerProcess:
-    """Starts the server on 127.0.0.1:port (a free one when None) with extra args; self.target is
-    its address once start() returned; stop() ends it and returns (exit code, log tail)."""
+    """Starts the server on 127.0.0.1:port (a free one when None) with extra args (after
+    --warm-up minimal, unless they name it); self.target is its address once start() returned;
+    stop() ends it and returns (exit code, log tail)."""
 
     def __init__(self, args=(), port=None):
         self.folder = tempfile.TemporaryDirectory()
@@ -46,9 +47,10 @@ class ServerProcess:
         self.port_file = os.path.join(self.folder.name, "port")
         self.log = open(os.path.join(self.folder.name, "server.log"), "w+b")
         env = dict(os.environ, EGL_PLATFORM="surfaceless", LP_NUM_THREADS="2")
+        warm_up = [] if "--warm-up" in args else ["--warm-up", "minimal"]
         self.process = subprocess.Popen(
             [SERVER, "--listen", self.target, "--port-file", self.port_file,
-             "--log-level", "warn", *args], env=env, stdout=self.log, stderr=subprocess.STDOUT)
+             "--log-level", "warn", *warm_up, *args], env=env, stdout=self.log, stderr=subprocess.STDOUT)
 
     def wait_started(self):
         """Waits for the port file (written once serving); raises RuntimeError with the log."""

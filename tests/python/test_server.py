@@ -54,9 +54,11 @@ def image_size(jpeg):
 
 class ServerProcessCase(unittest.TestCase):
     """A real server for the tests of a class: SERVER_ARGS extend its command line (a tokens file
-    written from TOKENS_FILE), and self.client connects with TOKEN."""
+    written from TOKENS_FILE), and self.client connects with TOKEN. WARM_UP: the server's
+    --warm-up (minimal: 2 s less a start; no test here times a session's first ticks)."""
 
     SERVER_ARGS = []
+    WARM_UP = "minimal"
     TOKENS_FILE = None
     TOKEN = None
 
@@ -73,8 +75,8 @@ class ServerProcessCase(unittest.TestCase):
                 file.write(cls.TOKENS_FILE)
             args += ["--tokens-file", cls.tokens_path]
         cls.process = subprocess.Popen(
-            [SERVER, "--listen", "127.0.0.1:0", "--port-file", port_file, "--log-level", "warn"]
-            + args, env=env, stdout=cls.log, stderr=subprocess.STDOUT)
+            [SERVER, "--listen", "127.0.0.1:0", "--port-file", port_file, "--log-level", "warn",
+             "--warm-up", cls.WARM_UP] + args, env=env, stdout=cls.log, stderr=subprocess.STDOUT)
         cls.client = None
         try:
             deadline = time.monotonic() + START_TIMEOUT_S

@@ -23,11 +23,17 @@ std::optional<ServerConfig> parse(std::vector<std::string> args, int* exit_code)
 
 TEST(ServerConfigTest, NamedChoicesAreReadByName) {
   int code = -1;
-  auto c = parse({"--renderer", "Surfaceless", "--spray-smoothing", "bilateral"}, &code);
+  auto c =
+      parse({"--renderer", "Surfaceless", "--spray-smoothing", "bilateral", "--warm-up", "Minimal"},
+            &code);
   ASSERT_TRUE(c);
   EXPECT_EQ(c->renderer, render::EglPlatformChoice::kSurfaceless);
   EXPECT_EQ(c->spray_smoothing, render::SpraySmoothing::kBilateral);
+  EXPECT_EQ(c->warm_up, render::WarmUp::kMinimal);
+  EXPECT_EQ(parse({}, &code)->warm_up, render::WarmUp::kFull);
   EXPECT_FALSE(parse({"--renderer", "vulkan"}, &code));
+  EXPECT_NE(code, 0);
+  EXPECT_FALSE(parse({"--warm-up", "none"}, &code));
   EXPECT_NE(code, 0);
 }
 
