@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -578,6 +579,8 @@ json measure_realtime(const sim::Scenario& scenario, const std::vector<sim::View
 }  // namespace
 
 int main(int argc, char** argv) {
+  // The scheduler's log goes to stdout, where the JSON goes: its warnings and errors only.
+  spdlog::set_level(spdlog::level::warn);
   CLI::App app{"Downpour benchmark: the standard scene, per stage and end to end, as JSON"};
   std::string scene = "highway_heavy_rain";
   int frames = 120;

@@ -20,6 +20,9 @@ namespace {
 constexpr int kWidth = 320, kHeight = 180;
 constexpr int kMinimalWidth = 64, kMinimalHeight = 36;
 constexpr int kFrames = 2;  // a drive's later ticks drawn
+// A session's ticks until the environment's sky face has been drawn on its own (the 43rd:
+// EnvironmentProbe::faces_due with its default six ticks a face).
+constexpr int kTicksToTheSkyFace = 43;
 
 std::vector<sim::ViewSpec> every_view(int width = kWidth, int height = kHeight) {
   std::vector<sim::ViewSpec> views;
@@ -69,8 +72,10 @@ std::shared_ptr<const sim::ClientImage> picture(sim::View v, bool depth) {
 // truck 22 m ahead in the lane, under `weather`, in a session of its own: its first ticks (dry
 // glass: the environment drawn whole, then its first face on its own at the seventh), then, if
 // `later_s` > 0, a few from then on (drops on the glass, spray behind the truck and the ego car's
-// tires).
-void draw_wet_drive(Renderer& renderer, const sim::Weather& weather, double later_s) {
+// tires) and, with `every_face`, more of the driver's view until each face has been drawn on its
+// own (the sky's at the session's 43rd tick).
+void draw_wet_drive(Renderer& renderer, const sim::Weather& weather, double later_s,
+                    bool every_face = false) {
   const sim::Scenario scenario = sim::highway_heavy_rain();
   sim::SimulationConfig config;
   config.road.initial_m = 0.003;
@@ -100,6 +105,17 @@ void draw_wet_drive(Renderer& renderer, const sim::Weather& weather, double late
   if (later_s <= 0.0) return;
   while (t < later_s - 1e-9) tick();
   session.draw(tick, kFrames);
+  if (every_face) {
+    // Then the car held where it is (the simulation's ticks are not what is warmed up here), its
+    // time going on: a face every sixth tick (environment_probe.hpp), the sky's last.
+    sim::SceneState held = simulation.state();
+    session.draw(
+        [&]() -> const sim::SceneState& {
+          held.sim_time_s += dt;
+          return held;
+        },
+        kTicksToTheSkyFace - 7 - kFrames, 1);
+  }
   // The views that take a client's picture over one, with its depth and the server's haze, and
   // without, each with its clean frame and water mask. (The outputs of the views of the server's
   // world need no variants of their own: the test draws them.)
@@ -162,8 +178,8 @@ void warm_up(Renderer& renderer, WarmUp level) {
   draw_wet_drive(renderer, rain, 1.0);
   sim::Weather night = rain;  // the lamps
   night.sun_altitude_deg = -20.0;
-  draw_wet_drive(renderer, night, 1.0);
-  sim::Weather low_sun = rain;  // the relief's shadows
+  draw_wet_drive(renderer, night, 1.0, true);  // the sky face alone compiles a variant at night
+  sim::Weather low_sun = rain;                 // the relief's shadows
   low_sun.cloudiness = 0.0;
   low_sun.sun_altitude_deg = 10.0;
   draw_wet_drive(renderer, low_sun, 0.0);

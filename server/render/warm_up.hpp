@@ -33,8 +33,9 @@ enum class WarmUp {
   // The built-in scenes in every view at 320x180, as sessions draw them: a drop on dry glass;
   // heavy rain with water standing on the road behind a truck, by day, at night and under a low
   // sun, each from a session's start (the environment probe drawn whole, then a face on its own)
-  // and, by day and at night, a second on (drops, spray), then over a client's pictures with and
-  // without their depth. 1.5-2 s on the development machine with Mesa's shader cache on disk
+  // and, by day and at night, a second on (drops, spray; at night on until each face of the
+  // environment has been drawn on its own), then over a client's pictures with and without their
+  // depth. 1.5-2 s on the development machine with Mesa's shader cache on disk
   // (5-6 s under ASan), 6 s without.
   kFull,
   // A drop on dry glass in every view at 64x36: proves the context, the programs and the

@@ -44,8 +44,8 @@ struct SchedulerOptions {
   render::RendererOptions renderer;
   int encoder_threads = 1;
   bool profile_passes = false;                     // glFinish after each pass (benchmarks)
-  render::WarmUp warm_up = render::WarmUp::kFull;  // before the loop serves (warm_up.hpp)
   std::shared_ptr<FrameObserver> observer;         // may be null
+  render::WarmUp warm_up = render::WarmUp::kFull;  // drawn before the loop serves (warm_up.hpp)
 };
 
 struct SchedulerStats {

@@ -102,9 +102,8 @@ class RenderWarmUpTest : public RenderAllocationsTest {};
 // MESA_SHADER_CACHE_DISABLE, as on a fresh machine or in a new container), the warm-up, then
 // sessions that need its variants: heavy rain behind a truck on a flooded road by day (the demo's
 // weather), under a low sun in a clear sky, at night, over a client's pictures, and with every
-// output. No tick compiles. (Not yet covered: at night a session's 43rd tick, the first to draw
-// the environment's sky face on its own, compiles one more variant, 130-160 ms; the night's drive
-// stops before it.)
+// output. No tick compiles. (The night's drive goes past a session's 43rd tick, the first to draw
+// the environment's sky face on its own: after a warm-up without it, it compiled for 130-160 ms.)
 TEST_F(RenderWarmUpTest, AfterItNoTickCompilesAShader) {
   const auto w0 = std::chrono::steady_clock::now();
   render::warm_up(renderer());
@@ -144,7 +143,7 @@ TEST_F(RenderWarmUpTest, AfterItNoTickCompilesAShader) {
   };
   for (const Case& c :
        {Case{"rain", Drive{}.weather, 2.0, {}}, Case{"low sun", low_sun, 2.0, {}},
-        Case{"night", night, 1.3, {}}, Case{"pictures", Drive{}.weather, 1.3, over, pictures},
+        Case{"night", night, 1.5, {}}, Case{"pictures", Drive{}.weather, 1.3, over, pictures},
         Case{"outputs", Drive{}.weather, 1.3, outputs}}) {
     const char* name = c.name;
     Drive d;
