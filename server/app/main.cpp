@@ -16,6 +16,7 @@
 #include <spdlog/spdlog.h>
 
 #include "grpc_health/v1/health.pb.h"
+#include "server/app/fatal_signals.hpp"
 #include "server/app/log_format.hpp"
 #include "server/app/metrics.hpp"
 #include "server/app/server_config.hpp"
@@ -388,6 +389,7 @@ int main(int argc, char** argv) {
   // It sets the environment: before anything that may start a thread (gRPC's credentials).
   render::choose_rasterizer_threads(config->render_threads);
   app::set_up_logging(*config);
+  app::report_fatal_signals();
   rpc::Authenticator auth;
   std::shared_ptr<grpc::ServerCredentials> credentials;
   if (!app::load_security(*config, auth, credentials)) return 2;

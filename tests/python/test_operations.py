@@ -1,9 +1,11 @@
 """Integration, for operators: the real server's version, Prometheus metrics, JSON logs, where a
-session lives (--advertise), and its health service described by reflection (as grpcurl asks)."""
+session lives (--advertise), its health service described by reflection (as grpcurl asks), and a
+crash's backtrace in the log."""
 
 import json
 import os
 import re
+import signal
 import time
 import unittest
 import urllib.request
@@ -15,7 +17,7 @@ from downpour.v1 import downpour_pb2 as pb
 from grpc_health.v1 import health_pb2
 from google.protobuf import descriptor_pb2
 
-from server_process import free_port
+from server_process import ServerProcess, free_port
 from test_server import REPO, SERVER, ServerProcessCase, inputs
 
 
@@ -183,6 +185,22 @@ class OperationsTest(ServerProcessCase):
         self.assertEqual(len(started), 1, lines)
         self.assertEqual(started[0]["session"], info.session_id)
         self.assertEqual(started[0]["level"], "info")
+
+
+class CrashReportTest(unittest.TestCase):
+    """A server that dies of a fault says so in its log: the signal, the thread and a backtrace
+    whose own frames addr2line can name; then it dies of that signal, as it would have."""
+
+    def test_a_fatal_signal_leaves_a_backtrace_in_the_log(self):
+        server = ServerProcess()
+        server.wait_started()
+        os.kill(server.process.pid, signal.SIGSEGV)
+        server.process.wait(timeout=15)
+        code, log = server.stop()
+        self.assertEqual(code, -signal.SIGSEGV, log)
+        self.assertIn(f"fatal signal 11 (SIGSEGV) sent by process {os.getpid()} on thread", log)
+        self.assertIn("backtrace:", log)
+        self.assertRegex(log, r"downpour-server\(\+0x[0-9a-f]+\)")
 
 
 if __name__ == "__main__":
