@@ -5,17 +5,29 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdint>
 #include <cstring>
 
 namespace downpour::app {
 namespace {
 
+// (GCC defines the first two; clang says it by __has_feature.)
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
 constexpr bool kSanitized = true;
 #else
 constexpr bool kSanitized = false;
 #endif
+#else
+constexpr bool kSanitized = false;
+#endif
+
+// Set by the first report: a fault while it is written (another signal, or another thread's),
+// dies of its signal at once.
+std::atomic<bool> g_reporting{false};
 
 constexpr int kSignals[] = {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT};
 
@@ -58,7 +70,12 @@ void say_number(long value) {
 }
 
 void on_fatal_signal(int signal, siginfo_t* info, void*) {
-  // One report: a second fault while reporting goes to the default action (SA_RESETHAND).
+  // One report (the same signal again meets the default action: SA_RESETHAND).
+  if (g_reporting.exchange(true)) {
+    ::signal(signal, SIG_DFL);
+    raise(signal);
+    return;
+  }
   say("\nfatal signal ");
   say_number(signal);
   say(" (SIG");
@@ -68,6 +85,8 @@ void on_fatal_signal(int signal, siginfo_t* info, void*) {
   if (info && info->si_code > 0) {  // a fault: where
     say(" at address ");
     say_hex(reinterpret_cast<std::uintptr_t>(info->si_addr));
+  } else if (info && info->si_pid == getpid()) {  // abort(), raise()
+    say(" raised by the server itself");
   } else if (info) {  // sent: by whom
     say(" sent by process ");
     say_number(info->si_pid);

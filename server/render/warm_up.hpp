@@ -35,7 +35,7 @@ enum class WarmUp {
   // sun, each from a session's start (the environment probe drawn whole, then a face on its own)
   // and, by day and at night, a second on (drops, spray; at night on until each face of the
   // environment has been drawn on its own), then over a client's pictures with and without their
-  // depth. 1.5-2 s on the development machine with Mesa's shader cache on disk
+  // depth. 1.7-2 s on the development machine with Mesa's shader cache on disk
   // (5-6 s under ASan), 6 s without.
   kFull,
   // A drop on dry glass in every view at 64x36: proves the context, the programs and the

@@ -5,6 +5,7 @@ crash's backtrace in the log."""
 import json
 import os
 import re
+import resource
 import signal
 import time
 import unittest
@@ -192,11 +193,19 @@ class CrashReportTest(unittest.TestCase):
     whose own frames addr2line can name; then it dies of that signal, as it would have."""
 
     def test_a_fatal_signal_leaves_a_backtrace_in_the_log(self):
-        server = ServerProcess()
-        server.wait_started()
-        os.kill(server.process.pid, signal.SIGSEGV)
-        server.process.wait(timeout=15)
-        code, log = server.stop()
+        # No core file from it (the server inherits the limit).
+        core = resource.getrlimit(resource.RLIMIT_CORE)
+        resource.setrlimit(resource.RLIMIT_CORE, (0, core[1]))
+        try:
+            server = ServerProcess()
+        finally:
+            resource.setrlimit(resource.RLIMIT_CORE, core)
+        try:
+            server.wait_started()
+            os.kill(server.process.pid, signal.SIGSEGV)
+            server.process.wait(timeout=15)
+        finally:
+            code, log = server.stop()
         self.assertEqual(code, -signal.SIGSEGV, log)
         self.assertIn(f"fatal signal 11 (SIGSEGV) sent by process {os.getpid()} on thread", log)
         self.assertIn("backtrace:", log)
