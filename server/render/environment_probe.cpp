@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <stdexcept>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -34,6 +35,11 @@ constexpr std::array<FaceAxes, EnvironmentProbe::kFaces> kFaceAxes{{
 }};
 
 constexpr float kNearM = 0.05f;
+
+// The faces refreshed between the front's turns, in order: the ground (the bonnet and the road,
+// which most drops show at their top), left, right and the sky.
+constexpr int kBetween[] = {5, 2, 3, 4};
+constexpr int kBetweenCount = static_cast<int>(std::size(kBetween));
 
 }  // namespace
 
@@ -164,6 +170,12 @@ void EnvironmentProbe::make_levels(const EnvironmentPrograms& p, int face) {
   glTextureParameteri(levels_view_.id(), GL_TEXTURE_MAX_LEVEL, levels_ - 1);
 }
 
+int EnvironmentProbe::ticks_until_each_face_alone(const EnvironmentConfig& config) {
+  // The front's first turn on its own is the second (turn 2); the faces between have turns 1, 3,
+  // 5, ..., the last of them 2 * kBetweenCount - 1, at its tick_ (the session's tick less one).
+  return 1 + (2 * kBetweenCount - 1) * std::max(config.ticks_per_face, 1);
+}
+
 const std::vector<EnvironmentProbe::Due>& EnvironmentProbe::faces_due(double time_s,
                                                                       bool complete) {
   std::vector<Due>& due = due_;
@@ -174,13 +186,12 @@ const std::vector<EnvironmentProbe::Due>& EnvironmentProbe::faces_due(double tim
     drawn_ = true;
     tick_ = 1;  // the front's next turn comes after the others' first
   } else if (time_s != last_time_s_) {
-    // Every ticks_per_face ticks a face: the front (+x) every other time; between, the ground
-    // (the bonnet and the road, which most drops show at their top), left, right and sky in turn.
+    // Every ticks_per_face ticks a face: the front (+x) every other time, kBetween's in turn
+    // between.
     const int every = std::max(config_.ticks_per_face, 1);
     if (tick_ % every == 0) {
-      constexpr int kBetween[] = {5, 2, 3, 4};
       const int turn = tick_ / every;
-      due.push_back({turn % 2 == 0 ? 0 : kBetween[(turn / 2) % 4], true});
+      due.push_back({turn % 2 == 0 ? 0 : kBetween[(turn / 2) % kBetweenCount], true});
     }
     ++tick_;
   }

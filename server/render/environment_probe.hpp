@@ -93,6 +93,9 @@ class EnvironmentProbe {
   };
   // (Kept by the probe, so that a tick allocates nothing.)
   const std::vector<Due>& faces_due(double time_s, bool complete);
+  // The ticks of a session (its first included) until each face has been drawn on its own once:
+  // the last of them draws the last face's first turn (the renderer's warm-up draws that many).
+  static int ticks_until_each_face_alone(const EnvironmentConfig& config);
   // A fixed environment instead of the world (tests): six faces of linear RGB, face_size^2 texels
   // each, rows from the bottom. The probe then never refreshes.
   void set_fixed(const std::array<std::vector<glm::vec3>, kFaces>& faces);

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "server/render/environment_probe.hpp"
 #include "server/render/renderer.hpp"
 #include "server/sim/glass_water_surface.hpp"
 #include "server/sim/scenario.hpp"
@@ -20,9 +21,6 @@ namespace {
 constexpr int kWidth = 320, kHeight = 180;
 constexpr int kMinimalWidth = 64, kMinimalHeight = 36;
 constexpr int kFrames = 2;  // a drive's later ticks drawn
-// A session's ticks until the environment's sky face has been drawn on its own (the 43rd:
-// EnvironmentProbe::faces_due with its default six ticks a face).
-constexpr int kTicksToTheSkyFace = 43;
 
 std::vector<sim::ViewSpec> every_view(int width = kWidth, int height = kHeight) {
   std::vector<sim::ViewSpec> views;
@@ -107,14 +105,15 @@ void draw_wet_drive(Renderer& renderer, const sim::Weather& weather, double late
   session.draw(tick, kFrames);
   if (every_face) {
     // Then the car held where it is (the simulation's ticks are not what is warmed up here), its
-    // time going on: a face every sixth tick (environment_probe.hpp), the sky's last.
+    // time going on, until the last face (the sky) has had its turn on its own.
     sim::SceneState held = simulation.state();
+    const int ticks = EnvironmentProbe::ticks_until_each_face_alone(EnvironmentConfig{});
     session.draw(
         [&]() -> const sim::SceneState& {
           held.sim_time_s += dt;
           return held;
         },
-        kTicksToTheSkyFace - 7 - kFrames, 1);
+        ticks - 7 - kFrames, 1);
   }
   // The views that take a client's picture over one, with its depth and the server's haze, and
   // without, each with its clean frame and water mask. (The outputs of the views of the server's

@@ -1,6 +1,7 @@
 // Render tests on llvmpipe: each view against a golden PNG, and properties a golden file cannot
 // fake. Set DOWNPOUR_UPDATE_GOLDEN=1 to rewrite the golden files after a deliberate change (then
 // look at them).
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -8,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "server/render/environment_probe.hpp"
 #include "server/render/renderer.hpp"
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"
@@ -161,6 +163,35 @@ TEST_F(RendererTest, TheLastStepsRainMovedOnDrawsAsTheStepsOwn) {
 TEST_F(RendererTest, SameSceneRendersTheSamePixels) {
   const sim::SceneState scene = highway_scene();
   EXPECT_EQ(render(sim::View::kCockpit, scene).pixels, render(sim::View::kCockpit, scene).pixels);
+}
+
+// The environment's schedule: after the first tick (every face), a face on its own every few
+// ticks, the front every other time. The count the warm-up draws to ends on the tick of the last
+// face's first turn alone, and by then each face but the back has had one.
+TEST_F(RendererTest, EachEnvironmentFaceIsDrawnAloneByTheWarmUpsCount) {
+  for (const int every : {6, 1, 4}) {
+    EnvironmentConfig config;
+    config.ticks_per_face = every;
+    EnvironmentProbe probe(config);
+    const int ticks = EnvironmentProbe::ticks_until_each_face_alone(config);
+    std::array<int, EnvironmentProbe::kFaces> first_alone{};
+    first_alone.fill(-1);
+    for (int tick = 0; tick < ticks; ++tick) {
+      const std::vector<EnvironmentProbe::Due>& due = probe.faces_due(tick / 30.0, false);
+      if (tick == 0) continue;  // all six
+      for (const EnvironmentProbe::Due& d : due) {
+        if (first_alone[d.face] < 0) first_alone[d.face] = tick;
+      }
+    }
+    EXPECT_EQ(first_alone[1], -1) << "the back is never drawn";
+    int last = -1;
+    for (int f = 0; f < EnvironmentProbe::kFaces; ++f) {
+      if (f == 1) continue;
+      EXPECT_GE(first_alone[f], 0) << "face " << f << ", every " << every;
+      last = std::max(last, first_alone[f]);
+    }
+    EXPECT_EQ(last, ticks - 1) << "every " << every;
+  }
 }
 
 }  // namespace
