@@ -8,6 +8,7 @@
 // thread's tick behind a truck on a wet road (--step-only: that alone). Reports, never fails on a
 // slow machine.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
@@ -33,6 +34,7 @@
 #include "server/session/frame_scheduler.hpp"
 #include "server/session/session_registry.hpp"
 #include "server/sim/scenario.hpp"
+#include "server/sim/worker_thread.hpp"
 #include "tests/render/road_water_fixture.hpp"
 #include "tests/support/spray_drive.hpp"
 
@@ -98,6 +100,7 @@ constexpr Ceiling kCeilings[] = {
 // The renderer every measurement makes (--renderer) and the pipeline's encoder workers.
 render::RendererOptions g_renderer;
 int g_encoder_threads = 1;
+bool g_step_helper = true;  // FrameScheduler's step helper (--one-step-thread: none)
 
 // A simulation that has run the scenario's drive for `seconds`, at its frame rate.
 void warm(sim::Simulation& simulation, const sim::Scenario& scenario, double seconds) {
@@ -188,34 +191,56 @@ json measure_step_thread(const sim::Scenario& scenario, int ticks, double warm_s
                          double film_mm) {
   sim::SimulationConfig config;
   config.road.initial_m = film_mm * 1e-3;
-  sim::Simulation simulation(scenario.seed, scenario.at(0.0), config);
   const double dt = 1.0 / scenario.fps;
   auto update = [&](double t) {
     return gap_m > 0.0 ? sim::behind_truck(scenario, t, gap_m) : scenario.at(t);
   };
-  for (int i = 0; i < static_cast<int>(warm_s * scenario.fps); ++i) {
-    simulation.apply(update(simulation.state().sim_time_s + dt));
-    simulation.advance(dt);
-  }
-  std::map<std::string, std::vector<double>> parts;
-  for (int i = 0; i < ticks; ++i) {
-    simulation.apply(update(simulation.state().sim_time_s + dt));
-    const auto t0 = Clock::now();
-    simulation.advance(dt);
-    parts["tick"].push_back(ms_between(t0, Clock::now()));
-    const sim::AdvanceTiming& a = simulation.last_advance_timing();
-    parts["water"].push_back(a.water_ms);
-    parts["publish"].push_back(a.publish_ms);
-    parts["glass_surface"].push_back(a.surface_ms);
-    parts["rain_field"].push_back(a.rain_ms);
-    parts["road_water"].push_back(a.road_ms);
-    parts["spray"].push_back(a.spray_ms);
-    parts["spray_image"].push_back(a.spray_image_ms);
+  // The server's step (the world outside the glass on a helper, as FrameScheduler runs it) and the
+  // same step on one thread, on two copies of the drive in turn, 30 ticks each, so that both see
+  // the same machine (tick by tick, each would find the caches full of the other's state).
+  sim::WorkerThread helper("dp-world");
+  struct Run {
+    sim::Simulation simulation;
+    sim::WorkerThread* helper;
+    std::map<std::string, std::vector<double>> parts;
+  };
+  std::array<Run, 2> runs{
+      Run{sim::Simulation(scenario.seed, scenario.at(0.0), config), &helper, {}},
+      Run{sim::Simulation(scenario.seed, scenario.at(0.0), config), nullptr, {}}};
+  constexpr int kBlock = 30;
+  const int warm_ticks = static_cast<int>(warm_s * scenario.fps);
+  for (int block = 0; block < warm_ticks + ticks; block += kBlock) {
+    for (Run& run : runs) {
+      for (int i = block; i < std::min(block + kBlock, warm_ticks + ticks); ++i) {
+        const bool measured = i >= warm_ticks;
+        sim::Simulation& simulation = run.simulation;
+        simulation.apply(update(simulation.state().sim_time_s + dt));
+        const auto t0 = Clock::now();
+        simulation.advance(dt, run.helper);
+        if (!measured) continue;
+        auto& parts = run.parts;
+        parts["tick"].push_back(ms_between(t0, Clock::now()));
+        const sim::AdvanceTiming& a = simulation.last_advance_timing();
+        parts["water"].push_back(a.water_ms);
+        parts["publish"].push_back(a.publish_ms);
+        parts["glass_surface"].push_back(a.surface_ms);
+        parts["rain_field"].push_back(a.rain_ms);
+        parts["road_water"].push_back(a.road_ms);
+        parts["spray"].push_back(a.spray_ms);
+        parts["spray_image"].push_back(a.spray_image_ms);
+        parts["waited"].push_back(a.waited_ms);
+      }
+    }
   }
   json j = {{"ticks", ticks}, {"truck_gap_m", gap_m}, {"road_film_mm", film_mm}};
-  for (const auto& [name, ms] : parts)
+  for (const auto& [name, ms] : runs[0].parts)
     j[name + "_ms"] = {{"median", median(ms)}, {"p90", percentile(ms, 0.9)}};
-  j["spray_parcels"] = simulation.spray().particles().size();
+  const std::vector<double>& alone = runs[1].parts["tick"];
+  j["tick_one_thread_ms"] = {{"median", median(alone)}, {"p90", percentile(alone, 0.9)}};
+  j["spray_parcels"] = runs[0].simulation.spray().particles().size();
+  j["same_state"] =
+      runs[0].simulation.state().windshield.drops == runs[1].simulation.state().windshield.drops &&
+      runs[0].simulation.water().mass_on_glass() == runs[1].simulation.water().mass_on_glass();
   return j;
 }
 
@@ -400,7 +425,13 @@ json measure_rain(const sim::Scenario& scenario, int frames, double warm_s) {
 // session whose scene has run for warm_s before the render thread starts.
 struct Pipeline {
   session::SessionRegistry registry{1, [this] { scheduler.wake(); }};
-  session::FrameScheduler scheduler{registry, {g_renderer, g_encoder_threads, false, nullptr}};
+  session::FrameScheduler scheduler{registry,
+                                    {.renderer = g_renderer,
+                                     .encoder_threads = g_encoder_threads,
+                                     .profile_passes = false,
+                                     .observer = nullptr,
+                                     .warm_up = render::WarmUp::kFull,
+                                     .step_helper = g_step_helper}};
   std::shared_ptr<session::Session> session;
 
   Pipeline(const sim::Scenario& scenario, std::vector<sim::ViewSpec> views, sim::Mode mode,
@@ -624,6 +655,8 @@ int main(int argc, char** argv) {
   app.add_flag("--step-only", step_only,
                "only the step thread's tick behind a truck on a wet road (no GL)");
   app.add_flag("--demo-only", demo_only, "only the demo session (COCKPIT + ROAD, realtime)");
+  app.add_flag("!--one-step-thread", g_step_helper,
+               "the server's step on one thread, without its helper (the demo, the pipeline)");
   bool outputs = false;
   app.add_flag("--outputs", outputs,
                "with --client-background: also with the clean frame and the water mask asked for");

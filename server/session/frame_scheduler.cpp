@@ -82,6 +82,7 @@ struct FrameScheduler::InFlight {
 FrameScheduler::FrameScheduler(SessionRegistry& registry, SchedulerOptions options)
     : registry_(registry),
       options_(options),
+      world_worker_(make_world_worker(options.step_helper)),
       // Room for two ticks of four views per encoder thread keeps the encoders fed without backlog.
       encoders_(options.encoder_threads, std::max(8, options.encoder_threads * 8)) {
   encoders_.set_on_idle_slot([this] { wake(); });
@@ -354,6 +355,11 @@ std::optional<StepJob> FrameScheduler::pop_step(Session& s) {
   return std::nullopt;
 }
 
+std::unique_ptr<sim::WorkerThread> FrameScheduler::make_world_worker(bool wanted) {
+  if (!wanted || std::thread::hardware_concurrency() < 2) return nullptr;
+  return std::make_unique<sim::WorkerThread>("dp-world");
+}
+
 FrameScheduler::StartedStep FrameScheduler::start_step(Session& s, double dt_s) {
   step_worker_.wait();  // one step at a time: another session's, started ahead, finishes first
   sim::Simulation& simulation = s.simulation();
@@ -361,9 +367,9 @@ FrameScheduler::StartedStep FrameScheduler::start_step(Session& s, double dt_s) 
   step.inputs = simulation.inputs_after(dt_s);
   step.failure = std::make_shared<std::exception_ptr>();
   // What the step throws is kept for the tick that waits for it (and rethrown there).
-  step_worker_.start([&simulation, dt_s, failure = step.failure] {
+  step_worker_.start([&simulation, dt_s, failure = step.failure, helper = world_worker_.get()] {
     try {
-      simulation.advance(dt_s);
+      simulation.advance(dt_s, helper);
     } catch (...) {
       *failure = std::current_exception();
     }

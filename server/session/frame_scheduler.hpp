@@ -46,6 +46,9 @@ struct SchedulerOptions {
   bool profile_passes = false;                     // glFinish after each pass (benchmarks)
   std::shared_ptr<FrameObserver> observer;         // may be null
   render::WarmUp warm_up = render::WarmUp::kFull;  // drawn before the loop serves (warm_up.hpp)
+  // The step's helper thread (the world outside the glass steps on it beside the glass's water);
+  // never on a machine with one core. The benchmark measures the demo without it too.
+  bool step_helper = true;
 };
 
 struct SchedulerStats {
@@ -95,6 +98,7 @@ class FrameScheduler {
   // A lockstep session's next step job, the updates queued before it applied; none if no step
   // waits.
   std::optional<StepJob> pop_step(Session& s);
+  static std::unique_ptr<sim::WorkerThread> make_world_worker(bool wanted);
   StartedStep start_step(Session& s, double dt_s);
   void tick(const std::shared_ptr<Session>& s, const StartedStep& step, StepDone done,
             Clock::time_point inputs_arrived);
@@ -123,6 +127,9 @@ class FrameScheduler {
   };
   std::optional<StepAhead> ahead_;
   Clock::time_point stats_published_;
+  // The step's helper: the world outside the glass steps on it beside the glass's water (none on
+  // a machine with one core). Declared first, so that it outlives the step thread's last job.
+  std::unique_ptr<sim::WorkerThread> world_worker_;
   sim::WorkerThread step_worker_{"dp-step"};
   std::thread thread_;
 

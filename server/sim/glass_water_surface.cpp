@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <functional>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 
 #include "server/sim/drop_physics.hpp"
+#include "server/sim/worker_thread.hpp"
 
 namespace downpour::sim {
 namespace {
@@ -67,29 +70,36 @@ double body_reach_mm(const WaterBody& b) {
   return b.half_length_mm + std::max({b.side_mm, b.front_mm, b.back_mm});
 }
 
-void GlassWaterSurface::index(const GlassConfig& glass) {
-  cells_u = std::max(1, static_cast<int>(std::ceil(glass.bottom_width_mm / kCellMm)));
-  cells_v = std::max(1, static_cast<int>(std::ceil(glass.height_mm / kCellMm)));
+namespace {
+
+// Every (cell, body) of a run of bodies where the cell overlaps the box around the body's outline
+// (in the frame of its axis: from back_mm behind its segment's start to front_mm beyond its end,
+// side_mm either side), and the cells whose centre lies within a body's outline, wet. A point
+// under water lies in a cell that lists its body; a drop of 1 mm radius is listed in 2.25 cells
+// on average. (The wet test has no branch: which cells pass is noise to a branch predictor.)
+struct Listing {
+  std::vector<std::uint64_t> pairs;  // cell << 32 | body; the first n_pairs are this run's
+  std::size_t n_pairs = 0;
+  std::vector<std::uint8_t> wet;  // a byte a cell, and two past the last
+};
+
+// The scratch is kept by each thread that lists (the step thread and its helper), bound once to a
+// reference: each use of a thread_local with a constructor goes through its guard.
+Listing& this_threads_listing() {
+  thread_local Listing listing;
+  return listing;
+}
+
+void list_bodies(const std::vector<WaterBody>& bodies, std::size_t k0, std::size_t k1, int cells_u,
+                 int cells_v, Listing& listing) {
   const std::size_t n_cells = static_cast<std::size_t>(cells_u) * cells_v;
-  const float cell = static_cast<float>(kCellMm);
-  // Every (cell, body) where the cell overlaps the box around the body's outline (in the frame of
-  // its axis: from back_mm behind its segment's start to front_mm beyond its end, side_mm either
-  // side), and the cells whose centre lies within a body's outline, wet. A point under water lies
-  // in a cell that lists its body; a drop of 1 mm radius is listed in 2.25 cells on average. (The
-  // scratch is kept by the thread, bound once to references: each use of a thread_local with a
-  // constructor goes through its guard. The wet test has no branch: which cells pass is noise to a
-  // branch predictor.)
-  thread_local std::vector<std::uint64_t> tls_pairs;
-  thread_local std::vector<std::uint32_t> tls_fill;
-  thread_local std::vector<std::uint8_t> tls_wet;
-  std::vector<std::uint64_t>& pairs = tls_pairs;
-  std::vector<std::uint32_t>& fill = tls_fill;
-  std::vector<std::uint8_t>& wet = tls_wet;
+  const float cell = static_cast<float>(GlassWaterSurface::kCellMm);
+  std::vector<std::uint64_t>& pairs = listing.pairs;
   std::size_t n_pairs = 0;
   // (Two bytes past the last cell: the small bodies' rows below are written three cells wide.)
-  wet.assign(n_cells + 2, 0);
-  std::uint8_t* const wet_cells_of = wet.data();
-  for (std::size_t k = 0; k < bodies.size(); ++k) {
+  listing.wet.assign(n_cells + 2, 0);
+  std::uint8_t* const wet_cells_of = listing.wet.data();
+  for (std::size_t k = k0; k < k1; ++k) {
     const WaterBody b = bodies[k];  // (a copy: the byte stores below may alias a reference)
     // The box's centre and half extents over the glass.
     const float shift = 0.5f * (b.front_mm - b.back_mm);
@@ -164,11 +174,67 @@ void GlassWaterSurface::index(const GlassConfig& glass) {
       }
     }
   }
+  listing.n_pairs = n_pairs;
+}
+
+}  // namespace
+
+void GlassWaterSurface::index(const GlassConfig& glass, WorkerThread* helper) {
+  cells_u = std::max(1, static_cast<int>(std::ceil(glass.bottom_width_mm / kCellMm)));
+  cells_v = std::max(1, static_cast<int>(std::ceil(glass.height_mm / kCellMm)));
+  const std::size_t n_cells = static_cast<std::size_t>(cells_u) * cells_v;
+  // With a helper that is idle, it lists the second half of the bodies while this thread lists
+  // the first (a busy one is not waited for).
+  constexpr std::size_t kShared = 2048;  // fewer bodies are listed sooner than a helper wakes
+  std::size_t half = bodies.size();
+  Listing& mine = this_threads_listing();
+  Listing* theirs = nullptr;
+  std::exception_ptr their_failure;
+  {
+    // However this thread's half ends, the helper finishes before the bodies can go.
+    struct Joined {
+      WorkerThread* helper = nullptr;
+      ~Joined() {
+        if (helper) helper->wait();
+      }
+    } joined;
+    if (helper && bodies.size() >= kShared) {
+      const std::size_t second = bodies.size() / 2;
+      std::function<void()> job = [&, second] {
+        try {
+          theirs = &this_threads_listing();
+          list_bodies(bodies, second, bodies.size(), cells_u, cells_v, *theirs);
+        } catch (...) {
+          their_failure = std::current_exception();
+        }
+      };
+      if (helper->try_start(job)) {
+        joined.helper = helper;
+        half = second;
+      }
+    }
+    list_bodies(bodies, 0, half, cells_u, cells_v, mine);
+  }
+  if (their_failure) std::rethrow_exception(their_failure);
+  // The halves in order: a cell's bodies keep their order, as if one thread had listed them all.
+  const Listing* const listings[2] = {&mine, theirs};
+  std::vector<std::uint8_t>& wet = mine.wet;
+  if (theirs) {
+    const std::uint8_t* const other = theirs->wet.data();
+    for (std::size_t c = 0; c < n_cells; ++c) wet[c] |= other[c];
+  }
   // A counting sort by cell (the pairs of a cell keep their bodies' order).
   cells.assign(n_cells, 0);
-  for (std::size_t p = 0; p < n_pairs; ++p) ++cells[pairs[p] >> 32];
+  std::size_t n_pairs = 0;
+  for (const Listing* l : listings) {
+    if (!l) continue;
+    for (std::size_t p = 0; p < l->n_pairs; ++p) ++cells[l->pairs[p] >> 32];
+    n_pairs += l->n_pairs;
+  }
   std::uint32_t first = 0;
   constexpr std::uint32_t kMaxCount = (1u << kCountBits) - 1;
+  thread_local std::vector<std::uint32_t> tls_fill;
+  std::vector<std::uint32_t>& fill = tls_fill;
   fill.resize(n_cells);
   for (std::size_t c = 0; c < n_cells; ++c) {
     const std::uint32_t count = cells[c];
@@ -177,8 +243,11 @@ void GlassWaterSurface::index(const GlassConfig& glass) {
     first += count;
   }
   entries.resize(n_pairs);
-  for (std::size_t p = 0; p < n_pairs; ++p)
-    entries[fill[pairs[p] >> 32]++] = static_cast<std::uint32_t>(pairs[p] & 0xffffffffu);
+  for (const Listing* l : listings) {
+    if (!l) continue;
+    for (std::size_t p = 0; p < l->n_pairs; ++p)
+      entries[fill[l->pairs[p] >> 32]++] = static_cast<std::uint32_t>(l->pairs[p] & 0xffffffffu);
+  }
   // The wet cells' centres over those within the glass's outline ([inset, width - inset] a row).
   std::size_t glass_cells = 0, wet_cells = 0;
   for (int j = 0; j < cells_v; ++j) {

@@ -16,6 +16,8 @@
 
 namespace downpour::sim {
 
+class WorkerThread;
+
 // One body of water, laid out as the renderer's texture buffer holds it (three RGBA texels; the
 // GLSL side is glass_surface.glsl's Body). Its outline, in the frame of its axis: the points within
 // side_mm across the axis and, along it, within front_mm beyond the end of its segment (the
@@ -65,8 +67,9 @@ struct GlassWaterSurface {
   // estimate: a drop smaller than a cell counts whole as often as its area is a cell's.
   double wet_fraction = 0.0;
 
-  // Lists every body in the cells its outline may reach; counts the wet cells.
-  void index(const GlassConfig& glass);
+  // Lists every body in the cells its outline may reach; counts the wet cells. With a helper
+  // (waited for first if it is busy), it lists half of the bodies; the result is the same.
+  void index(const GlassConfig& glass, WorkerThread* helper = nullptr);
 
   // The height of a cap as high as the body that rises highest over glass point p, of those its
   // cell lists (the renderer's water_top): > 0 where p lies under water. Needs index().

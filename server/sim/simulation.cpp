@@ -1,13 +1,17 @@
 #include "server/sim/simulation.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <exception>
+#include <limits>
 
 #include <glm/mat3x3.hpp>
 
 #include "server/sim/car_body.hpp"
 #include "server/sim/pose.hpp"
+#include "server/sim/worker_thread.hpp"
 
 namespace downpour::sim {
 namespace {
@@ -40,14 +44,18 @@ Simulation::Simulation(std::uint64_t seed, const Update& initial, SimulationConf
 }
 
 void Simulation::publish() {
+  publish_outside();
+  publish_glass();
+  publish_rest();
+}
+
+// The images of the world outside the glass: the rain in the air, the road's water, the spray.
+void Simulation::publish_outside() {
   using Clock = std::chrono::steady_clock;
-  const auto t_water = Clock::now();
-  water_.publish(state_.windshield);
   const auto t0 = Clock::now();
-  timing_.surface_ms = std::chrono::duration<double, std::milli>(t0 - t_water).count();
   rain_.publish(&state_.rain);
-  rain_ms_ +=
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const auto t1 = Clock::now();
+  rain_ms_ += std::chrono::duration<double, std::milli>(t1 - t0).count();
   if (road_image_stale_ || !state_.road_water) {
     auto image = std::make_shared<RoadWaterImage>();
     road_.image(*image);
@@ -58,8 +66,21 @@ void Simulation::publish() {
   auto spray = std::make_shared<SprayImage>();
   spray_.image(state_.vehicle.position_m, *spray);
   state_.spray = std::move(spray);
-  timing_.spray_image_ms =
-      std::chrono::duration<double, std::milli>(Clock::now() - t_spray).count();
+  const auto t2 = Clock::now();
+  timing_.spray_image_ms = std::chrono::duration<double, std::milli>(t2 - t_spray).count();
+  outside_publish_ms_ = std::chrono::duration<double, std::milli>(t2 - t1).count();
+}
+
+void Simulation::publish_glass(WorkerThread* helper) {
+  const auto t0 = std::chrono::steady_clock::now();
+  water_.publish(state_.windshield, helper);
+  timing_.surface_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// What follows from the steps of both: the water under the tires, where the car is, its wheels'
+// turn and the bodies' wetness.
+void Simulation::publish_rest() {
   // Under each tire: front left, front right, rear left, rear right.
   const glm::dmat4 to_world = vehicle_to_world(state_.vehicle);
   for (int t = 0; t < kTires; ++t) {
@@ -130,31 +151,109 @@ void Simulation::resolve_lights(bool vehicle_moved, bool traffic_moved) {
   }
 }
 
-void Simulation::advance(double dt_s) {
+void Simulation::advance(double dt_s, WorkerThread* helper) {
   using Clock = std::chrono::steady_clock;
-  const auto t0 = Clock::now();
   rain_ms_ = 0.0;
   road_ms_ = 0.0;
   spray_ms_ = 0.0;
   carry_s_ += dt_s;
   // The inputs are where the vehicles are at the end of this advance (as the frame draws them).
+  const std::uint64_t first = state_.sub_steps;
+  int due = 0;
   step_end_s_ = state_.sim_time_s;
-  for (double carry = carry_s_; whole_sub_step_due(carry); carry -= config_.sub_step_s)
+  for (; whole_sub_step_due(carry_s_); carry_s_ -= config_.sub_step_s) {
     step_end_s_ += config_.sub_step_s;
-  while (whole_sub_step_due(carry_s_)) {
-    sub_step();
-    carry_s_ -= config_.sub_step_s;
+    ++due;
   }
-  const auto t1 = Clock::now();
-  const double rain_step_ms = rain_ms_;
-  publish();
+  // The world outside the glass steps all of the advance's sub-steps on the helper (or first,
+  // without one) while the glass's water follows it. The spray's drops that land on the glass join
+  // its water at its first step after the sub-step they landed in (a 60th of a second at most):
+  // the glass never waits for the spray of the sub-step it steps in, and neither side reads what
+  // the other writes, so the state is the same bit for bit with a helper or without.
+  if (landed_.size() < static_cast<std::size_t>(due)) landed_.resize(due);
+  for (int k = 0; k < due; ++k) landed_[k].clear();  // (the outer vector stays as it is now)
+  std::atomic<int> outside_done{0};                  // sub-steps whose spray the outside has thrown
+  constexpr int kOutsideFailed = std::numeric_limits<int>::max();
+  std::exception_ptr outside_failure;
+  auto outside = [&] {
+    try {
+      for (int k = 1; k <= due; ++k) {
+        road_and_spray_sub_step(first + static_cast<std::uint64_t>(k), landed_[k - 1]);
+        outside_done.store(k, std::memory_order_release);
+        outside_done.notify_one();
+      }
+      // The rain in the air meets nothing else in the step: it goes last.
+      const auto r0 = Clock::now();
+      for (int k = 1; k <= due; ++k) {
+        const double time_s =
+            static_cast<double>(first + static_cast<std::uint64_t>(k)) * config_.sub_step_s;
+        rain_.advance(config_.sub_step_s, time_s, state_.weather, state_.vehicle);
+      }
+      rain_ms_ += std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
+      publish_outside();
+    } catch (...) {
+      outside_failure = std::current_exception();
+      outside_done.store(kOutsideFailed, std::memory_order_release);
+      outside_done.notify_one();
+    }
+  };
+  double waited_ms = 0.0;
+  {
+    // However the glass's steps end, the helper finishes before what it uses goes.
+    struct Joined {
+      WorkerThread* helper;
+      ~Joined() {
+        if (helper) helper->wait();
+      }
+    } joined{helper};
+    if (helper) {
+      helper->start(outside);
+    } else {
+      outside();
+    }
+    const auto g0 = Clock::now();
+    auto take = [this](const std::vector<LandedDrop>& drops) {
+      for (const LandedDrop& d : drops) water_.add_drop(d.uv_mm, d.mass_mg, true);
+    };
+    int taken = 0;  // the sub-steps of this advance whose drops the glass has taken
+    for (int k = 1; k <= due; ++k) {
+      if (!start_glass_sub_step()) continue;
+      int seen = outside_done.load(std::memory_order_acquire);
+      if (seen < k - 1) {
+        const auto w0 = Clock::now();
+        while (seen < k - 1) {
+          outside_done.wait(seen, std::memory_order_acquire);
+          seen = outside_done.load(std::memory_order_acquire);
+        }
+        waited_ms += std::chrono::duration<double, std::milli>(Clock::now() - w0).count();
+      }
+      if (seen == kOutsideFailed) break;
+      take(pending_);
+      pending_.clear();
+      for (; taken < k - 1; ++taken) take(landed_[taken]);
+      step_glass_water();
+    }
+    const auto t1 = Clock::now();
+    timing_.water_ms = std::chrono::duration<double, std::milli>(t1 - g0).count() - waited_ms;
+    publish_glass(helper);  // the helper, if done with the outside, shares the surface's index
+    const auto w0 = Clock::now();
+    if (helper) helper->wait();
+    waited_ms += std::chrono::duration<double, std::milli>(Clock::now() - w0).count();
+    // What landed since the glass's last step waits for its next one.
+    if (!outside_failure) {
+      for (; taken < due; ++taken)
+        pending_.insert(pending_.end(), landed_[taken].begin(), landed_[taken].end());
+    }
+  }
+  if (outside_failure) std::rethrow_exception(outside_failure);
+  const auto t2 = Clock::now();
+  publish_rest();
+  const double rest_ms = std::chrono::duration<double, std::milli>(Clock::now() - t2).count();
   timing_.rain_ms = rain_ms_;
   timing_.road_ms = road_ms_;
   timing_.spray_ms = spray_ms_;
-  timing_.water_ms = std::chrono::duration<double, std::milli>(t1 - t0).count() - rain_step_ms -
-                     road_ms_ - spray_ms_;
-  timing_.publish_ms = std::chrono::duration<double, std::milli>(Clock::now() - t1).count() -
-                       (rain_ms_ - rain_step_ms);
+  timing_.publish_ms = timing_.surface_ms + outside_publish_ms_ + rest_ms;
+  timing_.waited_ms = waited_ms;
 }
 
 bool Simulation::whole_sub_step_due(double carry_s) const {
@@ -203,33 +302,35 @@ glm::dvec3 Simulation::air_velocity_vehicle() const {
   return glm::transpose(to_world) * (wind_velocity(state_.weather) - state_.vehicle.velocity_mps);
 }
 
-void Simulation::sub_step() {
-  state_.sim_time_s = static_cast<double>(++state_.sub_steps) * config_.sub_step_s;
-  wipers_.advance(config_.sub_step_s, state_.wipers);
-  const auto t0 = std::chrono::steady_clock::now();
-  rain_.advance(config_.sub_step_s, state_.sim_time_s, state_.weather, state_.vehicle);
-  rain_ms_ +=
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+// The road's water and the spray at sub-step `n` of the session (`k` of the advance), at its time.
+void Simulation::road_and_spray_sub_step(std::uint64_t n, std::vector<LandedDrop>& landed) {
+  using Clock = std::chrono::steady_clock;
+  const double time_s = static_cast<double>(n) * config_.sub_step_s;
   if (config_.simulate_road && ++sub_steps_since_road_ >= config_.sub_steps_per_road_step) {
-    const auto r0 = std::chrono::steady_clock::now();
+    const auto r0 = Clock::now();
     road_.step(glm::dvec2(state_.vehicle.position_m), state_.weather.rain_rate_mm_h,
                sub_steps_since_road_ * config_.sub_step_s);
     sub_steps_since_road_ = 0;
     road_image_stale_ = true;
-    road_ms_ +=
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0).count();
+    road_ms_ += std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
   }
   if (config_.simulate_spray && ++sub_steps_since_spray_ >= config_.sub_steps_per_spray_step) {
-    const auto s0 = std::chrono::steady_clock::now();
-    spray_step();
+    const auto s0 = Clock::now();
+    spray_step(time_s, landed);
     sub_steps_since_spray_ = 0;
-    spray_ms_ +=
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - s0).count();
+    spray_ms_ += std::chrono::duration<double, std::milli>(Clock::now() - s0).count();
   }
-  if (!config_.simulate_water ||
-      ++sub_steps_since_water_ < config_.windshield.sub_steps_per_water_step) {
-    return;
-  }
+}
+
+// The clock and the wipers one sub-step on; whether the windshield's water steps in it.
+bool Simulation::start_glass_sub_step() {
+  state_.sim_time_s = static_cast<double>(++state_.sub_steps) * config_.sub_step_s;
+  wipers_.advance(config_.sub_step_s, state_.wipers);
+  return config_.simulate_water &&
+         ++sub_steps_since_water_ >= config_.windshield.sub_steps_per_water_step;
+}
+
+void Simulation::step_glass_water() {
   WaterInputs in;
   in.rain_rate_mm_h = state_.weather.rain_rate_mm_h;
   in.air_velocity_mps = air_velocity_vehicle();
@@ -243,9 +344,8 @@ void Simulation::sub_step() {
 // The ego car and the traffic throw spray from the road's water, each where it is at this
 // sub-step: its input is its pose at the end of the advance, so it is moved back along its
 // velocity; what crosses the glass becomes drops there.
-void Simulation::spray_step() {
-  const double ahead =
-      std::clamp(state_.sim_time_s - step_end_s_, -kMaxExtrapolationS, kMaxExtrapolationS);
+void Simulation::spray_step(double time_s, std::vector<LandedDrop>& landed) {
+  const double ahead = std::clamp(time_s - step_end_s_, -kMaxExtrapolationS, kMaxExtrapolationS);
   std::vector<SpraySource> sources;
   sources.reserve(state_.traffic.size() + 1);
   auto add = [&](std::uint32_t key, const VehicleState& state, glm::dvec3 size,
@@ -267,9 +367,13 @@ void Simulation::spray_step() {
     spray_.step(sources, wind_velocity(state_.weather), ground);
     return;
   }
-  spray_.step(
-      sources, wind_velocity(state_.weather), ground, &config_.windshield.glass,
-      [this](glm::dvec2 uv_mm, double mass_mg) { return water_.add_drop(uv_mm, mass_mg, true); });
+  // A drop that stays on the glass is kept for the glass's next step (advance()).
+  spray_.step(sources, wind_velocity(state_.weather), ground, &config_.windshield.glass,
+              [this, &landed](glm::dvec2 uv_mm, double mass_mg) {
+                if (!water_.holds(uv_mm, mass_mg)) return false;
+                landed.push_back({uv_mm, mass_mg});
+                return true;
+              });
 }
 
 }  // namespace downpour::sim

@@ -19,6 +19,8 @@
 
 namespace downpour::sim {
 
+class WorkerThread;
+
 // Where the time of the last advance() went (the benchmarks report it; the state never depends on
 // it).
 struct AdvanceTiming {
@@ -29,6 +31,9 @@ struct AdvanceTiming {
   double rain_ms = 0.0;         // the rain in the air: its steps and its copy for the renderer
   double road_ms = 0.0;         // the water on the road's steps
   double spray_ms = 0.0;        // the spray's steps
+  // The glass's water waiting for the world outside it (the spray that lands on the glass), when
+  // the outside steps on a helper thread.
+  double waited_ms = 0.0;
 };
 
 struct SimulationConfig {
@@ -92,8 +97,10 @@ class Simulation {
   Simulation(std::uint64_t seed, const Update& initial, SimulationConfig config = {});
 
   void apply(const Update& update);
-  // Advances by dt in whole sub-steps; the remainder carries into the next call.
-  void advance(double dt_s);
+  // Advances by dt in whole sub-steps; the remainder carries into the next call. With a helper,
+  // the world outside the glass (the rain in the air, the road's water, the spray) steps on it
+  // beside the windshield's water; the state is the same bit for bit with one or without.
+  void advance(double dt_s, WorkerThread* helper = nullptr);
   // The state as advance(dt_s) will leave it but for the windshield (left empty) and the rain (the
   // last step's, whose drops the rain layer moves on to the time after the step): the inputs and
   // the time after the step, for what can be drawn while the step runs.
@@ -109,9 +116,15 @@ class Simulation {
   glm::dvec3 air_velocity_vehicle() const;
 
  private:
-  void sub_step();
-  void spray_step();
-  void publish();
+  struct LandedDrop;
+  void road_and_spray_sub_step(std::uint64_t n, std::vector<LandedDrop>& landed);
+  bool start_glass_sub_step();
+  void step_glass_water();
+  void spray_step(double time_s, std::vector<LandedDrop>& landed);
+  void publish();  // all of the below, in turn
+  void publish_outside();
+  void publish_glass(WorkerThread* helper = nullptr);
+  void publish_rest();
   bool whole_sub_step_due(double carry_s) const;
 
   SimulationConfig config_;
@@ -144,8 +157,18 @@ class Simulation {
   double step_end_s_ = 0.0;
   double spray_ms_ = 0.0;
   AdvanceTiming timing_;
-  double rain_ms_ = 0.0;  // the rain field's time in this advance, so far
-  double road_ms_ = 0.0;  // the road water's, likewise
+  double rain_ms_ = 0.0;             // the rain field's time in this advance, so far
+  double road_ms_ = 0.0;             // the road water's, likewise
+  double outside_publish_ms_ = 0.0;  // publish_outside()'s road and spray images
+  // The spray's drops that stayed on the glass: this advance's by its sub-step (the outside's
+  // steps add them, the glass's steps take them in), and those that landed after the glass's last
+  // step of an earlier advance.
+  struct LandedDrop {
+    glm::dvec2 uv_mm;
+    double mass_mg;
+  };
+  std::vector<std::vector<LandedDrop>> landed_;
+  std::vector<LandedDrop> pending_;
 };
 
 }  // namespace downpour::sim

@@ -57,7 +57,7 @@ double WaterSim::mass_on_glass() const {
 }
 
 bool WaterSim::add_drop(glm::dvec2 pos, double mass, bool with_sub_metaballs) {
-  if (!config_.glass.contains(pos) || mass <= 0.0) return false;
+  if (!holds(pos, mass)) return false;
   arrived_ += mass;
   mesh_.place(pos, mass, with_sub_metaballs ? &rain_.random() : nullptr);
   return true;
@@ -131,7 +131,7 @@ std::shared_ptr<GlassWaterSurface> WaterSim::recycled_surface() const {
       });
 }
 
-void WaterSim::publish(WindshieldState& out) const {
+void WaterSim::publish(WindshieldState& out, WorkerThread* helper) const {
   const WaterConfig& w = config_.water;
   const WaterShapeConfig& shape = w.shape;
   out.metaballs.clear();
@@ -211,7 +211,7 @@ void WaterSim::publish(WindshieldState& out) const {
     add(p.pos, drop_radius_mm(p.mass));
     bodies.push_back(cap(p.pos, drop_radius_mm(p.mass)));
   }
-  surface->index(config_.glass);
+  surface->index(config_.glass, helper);
   out.glass_wet_fraction = surface->wet_fraction;
   out.surface = std::move(surface);
   out.blades = blades_;

@@ -25,6 +25,8 @@
 
 namespace downpour::sim {
 
+class WorkerThread;
+
 // Where the water went, mg: arrived = on the glass + wiped_off + drained + evaporated.
 struct WaterLedger {
   double arrived = 0.0;     // raindrops that hit the glass (and water placed by tests)
@@ -41,7 +43,8 @@ class WaterSim {
   WaterSim(const WindshieldConfig& config, std::uint64_t seed);
 
   void step(double dt_s, const WaterInputs& inputs);
-  void publish(WindshieldState& out) const;
+  // With a helper, it shares the surface's index (GlassWaterSurface::index).
+  void publish(WindshieldState& out, WorkerThread* helper = nullptr) const;
 
   WaterLedger ledger() const;
   double mass_on_glass() const;
@@ -53,6 +56,10 @@ class WaterSim {
   // Tests and tools: place water directly (counted as arrived). add_drop fuses into an occupied
   // cell; returns false outside the glass.
   bool add_drop(glm::dvec2 pos_mm, double mass_mg, bool with_sub_metaballs = false);
+  // Whether add_drop would keep this drop (on the glass, with water in it); any thread may ask.
+  bool holds(glm::dvec2 pos_mm, double mass_mg) const {
+    return config_.glass.contains(pos_mm) && mass_mg > 0.0;
+  }
   void add_particle(glm::dvec2 pos_mm, double mass_mg);
   int drop_at(glm::dvec2 pos_mm) const { return mesh_.drop_at(pos_mm); }  // -1 if none
   double particle_mass() const { return particles_.particle_mass(); }

@@ -40,6 +40,17 @@ void WorkerThread::start(std::function<void()> job) {
   cv_.notify_all();
 }
 
+bool WorkerThread::try_start(std::function<void()>& job) {
+  {
+    std::lock_guard lock(mutex_);
+    if (busy_) return false;
+    job_ = std::move(job);
+    busy_ = true;
+  }
+  cv_.notify_all();
+  return true;
+}
+
 void WorkerThread::wait() {
   std::unique_lock lock(mutex_);
   cv_.wait(lock, [this] { return !busy_; });

@@ -26,6 +26,8 @@ class WorkerThread {
   // Starts `job` on the thread; the previous one must have been waited for. The job must not
   // throw (catch inside it what it may throw, and keep it for whoever waits for it).
   void start(std::function<void()> job);
+  // Starts `job` if the thread is idle; false (and nothing started) while a job is running.
+  bool try_start(std::function<void()>& job);
   // Returns once the started job has finished (at once if none is running).
   void wait();
 

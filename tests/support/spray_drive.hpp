@@ -10,6 +10,7 @@
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"
 #include "server/sim/track.hpp"
+#include "server/sim/worker_thread.hpp"
 
 namespace downpour::testing {
 
@@ -44,6 +45,7 @@ struct SprayDrive {
   double rain_mm_h = 1.0;
   bool simulate_glass = true;
   std::uint64_t seed = 9;
+  sim::WorkerThread* helper = nullptr;  // the step's helper (Simulation::advance), as the server's
 };
 
 // Drives; `each` (if given) sees the simulation after every frame.
@@ -72,7 +74,7 @@ sim::Simulation drive(const SprayDrive& d, Each&& each) {
       traffic.push_back({o.id, on_track(s + o.gap_m, d.speed_mps, o.lane), o.size_m});
     u.traffic = traffic;
     sim.apply(u);
-    sim.advance(1.0 / 30.0);
+    sim.advance(1.0 / 30.0, d.helper);
     each(sim);
   }
   return sim;

@@ -5,8 +5,10 @@
 // their water).
 #include "server/sim/glass_water_surface.hpp"
 
+#include <atomic>
 #include <cmath>
 #include <set>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -16,6 +18,7 @@
 #include "server/sim/drop_physics.hpp"
 #include "server/sim/random.hpp"
 #include "server/sim/water.hpp"
+#include "server/sim/worker_thread.hpp"
 
 namespace downpour::sim {
 namespace {
@@ -115,6 +118,38 @@ TEST(GlassWaterSurfaceTest, EveryPointOfABodyIsListedInItsCell) {
   small.bodies.push_back(cap_body({60.0f * c, 60.0f * c}, 1.0f, 40.0));
   small.index(glass);
   EXPECT_EQ(small.entries.size(), 5u);
+}
+
+// The step's helper lists half of the bodies (Simulation::advance): the lists, their order and
+// the wet fraction are those of one thread listing them all. A busy helper is not waited for.
+TEST(GlassWaterSurfaceTest, AHelperListsHalfOfTheBodiesAndTheResultIsTheSame) {
+  const GlassConfig glass;
+  RandomStream random(11, 0);
+  GlassWaterSurface alone;
+  for (int k = 0; k < 6000; ++k) {  // past the count from which a helper shares the work
+    const glm::vec2 at(static_cast<float>(random.uniform(0.0, 1500.0)),
+                       static_cast<float>(random.uniform(0.0, 760.0)));
+    WaterBody b = cap_body(at, static_cast<float>(random.uniform(0.3, 9.0)), 40.0);
+    if (k % 4 == 1) b = cylinder_body(at, glm::normalize(glm::vec2(0.3f, -1.0f)), 0.5f, 3.0f, 40.0);
+    alone.bodies.push_back(b);
+  }
+  GlassWaterSurface helped = alone, busy = alone;
+  alone.index(glass);
+  WorkerThread helper("dp-test");
+  helped.index(glass, &helper);
+  EXPECT_EQ(helped.cells, alone.cells);
+  EXPECT_EQ(helped.entries, alone.entries);
+  EXPECT_EQ(helped.wet_fraction, alone.wet_fraction);
+  EXPECT_GT(alone.wet_fraction, 0.1);
+  std::atomic<bool> release{false};
+  helper.start([&release] {
+    while (!release.load()) std::this_thread::yield();
+  });
+  busy.index(glass, &helper);  // lists every body itself
+  release = true;
+  helper.wait();
+  EXPECT_EQ(busy.entries, alone.entries);
+  EXPECT_EQ(busy.wet_fraction, alone.wet_fraction);
 }
 
 TEST(GlassWaterSurfaceTest, TheWetCellsAreThoseWhoseCentreLiesUnderWater) {

@@ -5,7 +5,10 @@
 
 #include <pthread.h>
 
+#include <atomic>
+#include <functional>
 #include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -32,6 +35,23 @@ TEST(WorkerThreadTest, RunsItsJobsUnderItsName) {
     worker.wait();
   }
   EXPECT_EQ(sum, 6);
+}
+
+TEST(WorkerThreadTest, TryStartStartsOnlyWhenIdle) {
+  WorkerThread worker("dp-test");
+  std::atomic<bool> release{false};
+  worker.start([&release] {
+    while (!release.load()) std::this_thread::yield();
+  });
+  int ran = 0;
+  std::function<void()> job = [&ran] { ++ran; };
+  EXPECT_FALSE(worker.try_start(job));
+  EXPECT_TRUE(job);  // not taken
+  release = true;
+  worker.wait();
+  EXPECT_TRUE(worker.try_start(job));
+  worker.wait();
+  EXPECT_EQ(ran, 1);
 }
 
 TEST(WorkerThreadTest, ALongNameIsCutToWhatAThreadHolds) {
