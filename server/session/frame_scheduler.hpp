@@ -127,8 +127,9 @@ class FrameScheduler {
   };
   std::optional<StepAhead> ahead_;
   Clock::time_point stats_published_;
-  // The step's helper: the world outside the glass steps on it beside the glass's water (none on
-  // a machine with one core). Declared first, so that it outlives the step thread's last job.
+  // The step's helper: the world outside the glass steps on it beside the glass's water (none
+  // where the server may run on one core only). Declared before the step thread, so that it
+  // outlives the step thread's last job.
   std::unique_ptr<sim::WorkerThread> world_worker_;
   sim::WorkerThread step_worker_{"dp-step"};
   std::thread thread_;

@@ -185,7 +185,6 @@ void GlassWaterSurface::index(const GlassConfig& glass, WorkerThread* helper) {
   const std::size_t n_cells = static_cast<std::size_t>(cells_u) * cells_v;
   // With a helper that is idle, it lists the second half of the bodies while this thread lists
   // the first (a busy one is not waited for).
-  constexpr std::size_t kShared = 2048;  // fewer bodies are listed sooner than a helper wakes
   std::size_t half = bodies.size();
   Listing& mine = this_threads_listing();
   Listing* theirs = nullptr;
@@ -198,7 +197,7 @@ void GlassWaterSurface::index(const GlassConfig& glass, WorkerThread* helper) {
         if (helper) helper->wait();
       }
     } joined;
-    if (helper && bodies.size() >= kShared) {
+    if (helper && bodies.size() >= kShareFrom) {
       const std::size_t second = bodies.size() / 2;
       std::function<void()> job = [&, second] {
         try {

@@ -6,6 +6,7 @@
 // frames report, is read from here. Glass space, millimetres; plain data, no GL.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -67,8 +68,10 @@ struct GlassWaterSurface {
   // estimate: a drop smaller than a cell counts whole as often as its area is a cell's.
   double wet_fraction = 0.0;
 
-  // Lists every body in the cells its outline may reach; counts the wet cells. With a helper
-  // (waited for first if it is busy), it lists half of the bodies; the result is the same.
+  // Lists every body in the cells its outline may reach; counts the wet cells. With a helper that
+  // is idle and at least kShareFrom bodies, the helper lists half of them (a busy one is not
+  // waited for); the result is the same.
+  static constexpr std::size_t kShareFrom = 2048;  // fewer are listed sooner than a helper wakes
   void index(const GlassConfig& glass, WorkerThread* helper = nullptr);
 
   // The height of a cap as high as the body that rises highest over glass point p, of those its

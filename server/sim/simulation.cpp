@@ -167,9 +167,10 @@ void Simulation::advance(double dt_s, WorkerThread* helper) {
   }
   // The world outside the glass steps all of the advance's sub-steps on the helper (or first,
   // without one) while the glass's water follows it. The spray's drops that land on the glass join
-  // its water at its first step after the sub-step they landed in (a 60th of a second at most):
-  // the glass never waits for the spray of the sub-step it steps in, and neither side reads what
-  // the other writes, so the state is the same bit for bit with a helper or without.
+  // its water at its first step after the sub-step they landed in (one water step later at most),
+  // so the glass never waits for the spray of the sub-step it steps in. Apart from those drops,
+  // handed over through `outside_done`, neither side reads what the other writes, so the state is
+  // the same bit for bit with a helper or without.
   if (landed_.size() < static_cast<std::size_t>(due)) landed_.resize(due);
   for (int k = 0; k < due; ++k) landed_[k].clear();  // (the outer vector stays as it is now)
   std::atomic<int> outside_done{0};                  // sub-steps whose spray the outside has thrown

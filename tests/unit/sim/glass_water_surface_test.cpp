@@ -126,7 +126,7 @@ TEST(GlassWaterSurfaceTest, AHelperListsHalfOfTheBodiesAndTheResultIsTheSame) {
   const GlassConfig glass;
   RandomStream random(11, 0);
   GlassWaterSurface alone;
-  for (int k = 0; k < 6000; ++k) {  // past the count from which a helper shares the work
+  for (std::size_t k = 0; k < 3 * GlassWaterSurface::kShareFrom; ++k) {  // a helper shares them
     const glm::vec2 at(static_cast<float>(random.uniform(0.0, 1500.0)),
                        static_cast<float>(random.uniform(0.0, 760.0)));
     WaterBody b = cap_body(at, static_cast<float>(random.uniform(0.3, 9.0)), 40.0);
@@ -148,6 +148,7 @@ TEST(GlassWaterSurfaceTest, AHelperListsHalfOfTheBodiesAndTheResultIsTheSame) {
   busy.index(glass, &helper);  // lists every body itself
   release = true;
   helper.wait();
+  EXPECT_EQ(busy.cells, alone.cells);
   EXPECT_EQ(busy.entries, alone.entries);
   EXPECT_EQ(busy.wet_fraction, alone.wet_fraction);
 }

@@ -71,5 +71,44 @@ TEST(SimulationTest, AHelperThreadLeavesEveryTickTheSame) {
   EXPECT_GT(b.water().drop_count(), 0u);
 }
 
+// The hand-over at other rates: the glass's water every sub-step, every 3 and every 8, and steps
+// of uneven length, some shorter than a sub-step (an advance with no sub-step in it), others
+// several water steps long.
+TEST(SimulationTest, AHelperThreadLeavesTheStateTheSameAtOtherRatesAndSteps) {
+  for (const int water_every : {1, 3, 8}) {
+    SCOPED_TRACE(water_every);
+    SimulationConfig config;
+    config.road.initial_m = 0.0008;
+    config.windshield.sub_steps_per_water_step = water_every;
+    Update start;
+    double s = 400.0;
+    constexpr double kSpeed = 25.0;
+    start.vehicle = testing::on_track(s, kSpeed);
+    Weather w;
+    w.rain_rate_mm_h = 8.0;
+    start.weather = w;
+    Simulation alone(9, start, config), helped(9, start, config);
+    WorkerThread helper("dp-world");
+    const double steps[] = {1.0 / 30.0, 0.001, 0.05, 1.0 / 240.0, 0.003, 0.02};
+    double t = 0.0;
+    for (int i = 0; t < 1.5; ++i) {
+      const double dt = steps[i % 6];
+      t += dt;
+      s += kSpeed * dt;
+      Update u;
+      u.client_time_s = t;
+      u.vehicle = testing::on_track(s, kSpeed);
+      u.traffic = std::vector<TrafficVehicle>{
+          {1, testing::on_track(s + 14.0, kSpeed), testing::kTruckSize}};
+      alone.apply(u);
+      helped.apply(u);
+      alone.advance(dt);
+      helped.advance(dt, &helper);
+      ASSERT_EQ(digest(alone), digest(helped)) << "step " << i << ", dt " << dt;
+    }
+    EXPECT_GT(alone.spray().ledger().on_glass_m3, 0.0);
+  }
+}
+
 }  // namespace
 }  // namespace downpour::sim
