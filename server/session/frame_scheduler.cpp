@@ -1,7 +1,6 @@
 #include "server/session/frame_scheduler.hpp"
 
 #include <malloc.h>
-#include <sched.h>
 
 #include <algorithm>
 #include <future>
@@ -357,13 +356,7 @@ std::optional<StepJob> FrameScheduler::pop_step(Session& s) {
 }
 
 std::unique_ptr<sim::WorkerThread> FrameScheduler::make_world_worker(bool wanted) {
-  // The cores this process may run on (a container's CPU set, taskset), not the machine's.
-  cpu_set_t allowed;
-  CPU_ZERO(&allowed);
-  const int cores = sched_getaffinity(0, sizeof allowed, &allowed) == 0
-                        ? CPU_COUNT(&allowed)
-                        : static_cast<int>(std::thread::hardware_concurrency());
-  if (!wanted || cores < 2) return nullptr;
+  if (!wanted || sim::usable_cores() < 2) return nullptr;
   return std::make_unique<sim::WorkerThread>("dp-world");
 }
 

@@ -1,7 +1,9 @@
 #include "server/sim/worker_thread.hpp"
 
 #include <pthread.h>
+#include <sched.h>
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -13,6 +15,14 @@ void name_this_thread(const char* name) {
   char shortened[16] = {};
   std::strncpy(shortened, name, sizeof shortened - 1);
   pthread_setname_np(pthread_self(), shortened);
+}
+
+unsigned usable_cores() {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  return sched_getaffinity(0, sizeof allowed, &allowed) == 0
+             ? static_cast<unsigned>(CPU_COUNT(&allowed))
+             : std::max(1u, std::thread::hardware_concurrency());
 }
 
 WorkerThread::WorkerThread(const char* name)

@@ -16,6 +16,10 @@ namespace downpour::sim {
 // Names a thread as `top -H`, perf and gdb show it (at most 15 characters).
 void name_this_thread(const char* name);
 
+// The cores this process may run on (taskset, a container's CPU set), not all the machine's: what
+// the threads the server starts are sized by.
+unsigned usable_cores();
+
 class WorkerThread {
  public:
   // `name`: the thread's (name_this_thread).

@@ -1,19 +1,16 @@
 #include "server/render/gl/egl_context.hpp"
 
-#include <sched.h>
-
-#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 
 #include "server/render/gl/gl.hpp"
+#include "server/sim/worker_thread.hpp"
 
 namespace downpour::render {
 namespace {
@@ -66,11 +63,7 @@ EGLDisplay open_surfaceless_display() {
 }  // namespace
 
 void choose_rasterizer_threads(int requested) {
-  // The cores this process may run on (taskset, a container's cpuset), not all the machine's.
-  cpu_set_t allowed;
-  const unsigned cores = sched_getaffinity(0, sizeof allowed, &allowed) == 0
-                             ? static_cast<unsigned>(CPU_COUNT(&allowed))
-                             : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned cores = sim::usable_cores();
   const std::string threads =
       std::to_string(requested > 0 ? static_cast<unsigned>(requested) : cores + 1);
   setenv("LP_NUM_THREADS", threads.c_str(), requested > 0 ? 1 : 0);
