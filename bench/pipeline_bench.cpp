@@ -607,6 +607,48 @@ json measure_realtime(const sim::Scenario& scenario, const std::vector<sim::View
           {"cores_busy", cpu_ms / (wall_ms * std::max(1u, std::thread::hardware_concurrency()))}};
 }
 
+// The demo's session: COCKPIT and ROAD at 640x360.
+std::vector<sim::ViewSpec> demo_views() {
+  return {sim::view_spec(sim::View::kCockpit, 640, 360),
+          sim::view_spec(sim::View::kRoad, 640, 360)};
+}
+
+// The pipeline with the step's helper and without it (FrameScheduler's step_helper), `pairs` pairs
+// in turn in this one process: the machine's speed drifts by a fifth from one process to the next
+// and over a minute, more than the difference measured. Per pair: COCKPIT at `spec` pipelined and
+// in real time, and the demo's session in real time; the medians each way and of the pairs' ratios.
+json measure_step_helper_pairs(const sim::Scenario& scenario, const sim::ViewSpec& spec,
+                               const std::vector<sim::ViewSpec>& demo, int pairs, int frames,
+                               double realtime_s, double warm_s) {
+  std::map<std::string, std::array<std::vector<double>, 2>> runs;  // [with, without]
+  for (int k = 0; k < pairs; ++k) {
+    for (const bool with : {true, false}) {
+      g_step_helper = with;
+      auto into = [&](const char* name) -> std::vector<double>& { return runs[name][!with]; };
+      into("pipelined_fps")
+          .push_back(measure_pipeline(scenario, spec, frames, 3, warm_s)["fps"].get<double>());
+      const json realtime = measure_realtime(scenario, {spec}, realtime_s, warm_s);
+      into("realtime_fps").push_back(realtime["fps"].get<double>());
+      into("realtime_latency_frames").push_back(realtime["latency_frames"].get<double>());
+      const json d = measure_realtime(scenario, demo, realtime_s, warm_s);
+      into("demo_fps").push_back(d["fps"].get<double>());
+      into("demo_latency_frames").push_back(d["latency_frames"].get<double>());
+    }
+  }
+  g_step_helper = true;
+  json j = {{"pairs", pairs}};
+  for (const auto& [name, both] : runs) {
+    std::vector<double> ratios;
+    for (std::size_t k = 0; k < both[0].size(); ++k) ratios.push_back(both[0][k] / both[1][k]);
+    j[name] = {{"with_helper", both[0]},
+               {"without", both[1]},
+               {"median_with", median(both[0])},
+               {"median_without", median(both[1])},
+               {"median_ratio", median(ratios)}};
+  }
+  return j;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -655,6 +697,12 @@ int main(int argc, char** argv) {
   app.add_flag("--step-only", step_only,
                "only the step thread's tick behind a truck on a wet road (no GL)");
   app.add_flag("--demo-only", demo_only, "only the demo session (COCKPIT + ROAD, realtime)");
+  int step_helper_pairs = 0;
+  app.add_option("--step-helper-pairs", step_helper_pairs,
+                 "only: this many pairs of the pipeline with the step's helper and without, in "
+                 "turn in one process (COCKPIT at the first size, pipelined and realtime; the "
+                 "demo)")
+      ->check(CLI::Range(1, 50));
   app.add_flag("!--one-step-thread", g_step_helper,
                "the server's step on one thread, without its helper (the demo, the pipeline)");
   bool outputs = false;
@@ -699,6 +747,19 @@ int main(int argc, char** argv) {
       r["size"] = size;
       out["client_background"].push_back(r);
     }
+    std::printf("%s\n", out.dump(2).c_str());
+    return 0;
+  }
+  if (step_helper_pairs > 0) {
+    int width = 0, height = 0;
+    if (sizes.empty() || std::sscanf(sizes[0].c_str(), "%dx%d", &width, &height) != 2) {
+      std::fprintf(stderr, "--step-helper-pairs needs a size\n");
+      return 2;
+    }
+    out["step_helper_pairs"] =
+        measure_step_helper_pairs(scenario, sim::view_spec(sim::View::kCockpit, width, height),
+                                  demo_views(), step_helper_pairs, frames, realtime_s, warm_s);
+    out["step_helper_pairs"]["size"] = sizes[0];
     std::printf("%s\n", out.dump(2).c_str());
     return 0;
   }
@@ -749,9 +810,7 @@ int main(int argc, char** argv) {
   if (!rain_only && !demo_only)
     out["wet_road"] = measure_wet_road(scenario, std::min(frames, 30), std::min(warm_s, 2.0));
   if ((demo || demo_only) && !rain_only && !wet_road_only) {
-    const std::vector<sim::ViewSpec> views = {sim::view_spec(sim::View::kCockpit, 640, 360),
-                                              sim::view_spec(sim::View::kRoad, 640, 360)};
-    out["demo"] = measure_realtime(scenario, views, realtime_s, warm_s);
+    out["demo"] = measure_realtime(scenario, demo_views(), realtime_s, warm_s);
     out["demo"]["views"] = "COCKPIT + ROAD, 640x360";
   }
   // The budget table: each pass's median at every size measured, beside its ceiling.
