@@ -1,7 +1,7 @@
 // Fuzz target: the simulation under a feed a client could send. The input is a sequence of
 // (length, DriveRequest bytes) records; each request the service would accept is applied and the
-// simulation advanced by its dt_s (capped at 0.2 s per input, with a small rain box and road, so
-// that one input stays quick). After every step the state
+// simulation advanced by its dt_s as the server steps it, with the step's helper thread (capped at
+// 0.2 s per input, with a small rain box and road, so that one input stays quick). After every step the state
 // must be finite and the water must be accounted for: what arrived on the glass is on it, wiped
 // off, drained or evaporated; the rain in the air stays bounded and finite; the road's water is
 // finite and its ledger closes.
@@ -19,6 +19,7 @@
 #include "downpour/v1/downpour.pb.h"
 #include "server/rpc/validation.hpp"
 #include "server/sim/simulation.hpp"
+#include "server/sim/worker_thread.hpp"
 
 namespace {
 
@@ -99,6 +100,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     fresh[seed] = std::make_unique<sim::Simulation>(seed, initial, config);
   }
   sim::Simulation simulation = *fresh[seed];
+  static sim::WorkerThread helper("dp-world");
   double budget_s = 0.2;  // simulated time per input: 48 sub-steps, a wiper stroke's start
   while (in.remaining_bytes() > 0 && budget_s > 0.0) {
     const std::string bytes = in.ConsumeRandomLengthString(512);
@@ -110,7 +112,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     simulation.apply(update);
     const double dt = std::min(req.dt_s(), std::min(0.1, budget_s));
     budget_s -= std::max(dt, 0.01);
-    if (dt > 0.0) simulation.advance(dt);
+    if (dt > 0.0) simulation.advance(dt, &helper);
     check(simulation);
   }
   return 0;
