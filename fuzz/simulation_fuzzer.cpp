@@ -1,10 +1,10 @@
 // Fuzz target: the simulation under a feed a client could send. The input is a sequence of
 // (length, DriveRequest bytes) records; each request the service would accept is applied and the
 // simulation advanced by its dt_s as the server steps it, with the step's helper thread (capped at
-// 0.2 s per input, with a small rain box and road, so that one input stays quick). After every step the state
-// must be finite and the water must be accounted for: what arrived on the glass is on it, wiped
-// off, drained or evaporated; the rain in the air stays bounded and finite; the road's water is
-// finite and its ledger closes.
+// 0.2 s per input, with a small rain box and road, so that one input stays quick). After every step
+// the state must be finite and the water must be accounted for: what arrived on the glass is on it,
+// wiped off, drained or evaporated; the rain in the air stays bounded and finite; the road's water
+// is finite and its ledger closes.
 #include <algorithm>
 #include <array>
 #include <cmath>
