@@ -190,13 +190,7 @@ void GlassWaterSurface::index(const GlassConfig& glass, WorkerThread* helper) {
   Listing* theirs = nullptr;
   std::exception_ptr their_failure;
   {
-    // However this thread's half ends, the helper finishes before the bodies can go.
-    struct Joined {
-      WorkerThread* helper = nullptr;
-      ~Joined() {
-        if (helper) helper->wait();
-      }
-    } joined;
+    WaitOnExit joined;  // once started, the helper finishes before the bodies can go
     if (helper && bodies.size() >= kShareFrom) {
       const std::size_t second = bodies.size() / 2;
       std::function<void()> job = [&, second] {
@@ -208,7 +202,7 @@ void GlassWaterSurface::index(const GlassConfig& glass, WorkerThread* helper) {
         }
       };
       if (helper->try_start(job)) {
-        joined.helper = helper;
+        joined.set(helper);
         half = second;
       }
     }

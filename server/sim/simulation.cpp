@@ -200,13 +200,7 @@ void Simulation::advance(double dt_s, WorkerThread* helper) {
   };
   double waited_ms = 0.0;
   {
-    // However the glass's steps end, the helper finishes before what it uses goes.
-    struct Joined {
-      WorkerThread* helper;
-      ~Joined() {
-        if (helper) helper->wait();
-      }
-    } joined{helper};
+    const WaitOnExit joined(helper);  // the helper finishes before what it uses goes
     if (helper) {
       helper->start(outside);
     } else {

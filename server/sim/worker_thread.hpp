@@ -47,4 +47,20 @@ class WorkerThread {
   std::thread thread_;
 };
 
+// Waits for a worker's job when the scope it is in ends, however it ends (a throw included): for a
+// job that uses the scope's locals. Waits for nothing while it has no worker.
+class WaitOnExit {
+ public:
+  explicit WaitOnExit(WorkerThread* worker = nullptr) : worker_(worker) {}
+  ~WaitOnExit() {
+    if (worker_) worker_->wait();
+  }
+  WaitOnExit(const WaitOnExit&) = delete;
+  WaitOnExit& operator=(const WaitOnExit&) = delete;
+  void set(WorkerThread* worker) { worker_ = worker; }
+
+ private:
+  WorkerThread* worker_;
+};
+
 }  // namespace downpour::sim

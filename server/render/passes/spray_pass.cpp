@@ -222,10 +222,7 @@ void SprayPass::splat_on_cpu(const FrameTarget& maps, int haze_width, int haze_h
   const SprayCamera quarter{haze_width, haze_height, tan};
   // The haze on the helper thread while this one draws the liquid's maps.
   helper_.start([this, quarter] { splat_haze(quarter, clouds_, haze_pixels_); });
-  struct Join {
-    sim::WorkerThread& helper;
-    ~Join() { helper.wait(); }  // before anything it reads goes, even if this throws
-  } join{helper_};
+  const sim::WaitOnExit join(&helper_);  // before anything it reads goes, even if this throws
   splat_depth(layer, body_, spray_, maps_);
   helper_.wait();
   for (int y = 0; y < height; ++y) {

@@ -6,7 +6,9 @@
 #include <pthread.h>
 
 #include <atomic>
+#include <chrono>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <thread>
 
@@ -52,6 +54,21 @@ TEST(WorkerThreadTest, TryStartStartsOnlyWhenIdle) {
   EXPECT_TRUE(worker.try_start(job));
   worker.wait();
   EXPECT_EQ(ran, 1);
+}
+
+TEST(WorkerThreadTest, WaitOnExitWaitsForTheJobWhenAThrowEndsTheScope) {
+  WorkerThread worker("dp-test");
+  std::atomic<bool> done{false};
+  try {
+    worker.start([&done] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      done = true;
+    });
+    const WaitOnExit waits(&worker);
+    throw std::runtime_error("the scope ends");
+  } catch (const std::runtime_error&) {
+    EXPECT_TRUE(done.load());
+  }
 }
 
 TEST(WorkerThreadTest, ALongNameIsCutToWhatAThreadHolds) {
