@@ -238,9 +238,6 @@ json measure_step_thread(const sim::Scenario& scenario, int ticks, double warm_s
   const std::vector<double>& alone = runs[1].parts["tick"];
   j["tick_one_thread_ms"] = {{"median", median(alone)}, {"p90", percentile(alone, 0.9)}};
   j["spray_parcels"] = runs[0].simulation.spray().particles().size();
-  j["same_state"] =
-      runs[0].simulation.state().windshield.drops == runs[1].simulation.state().windshield.drops &&
-      runs[0].simulation.water().mass_on_glass() == runs[1].simulation.water().mass_on_glass();
   return j;
 }
 
