@@ -372,6 +372,16 @@ json measure_wet_road(const sim::Scenario& scenario, int frames, double warm_s) 
     // Terrain, drawn the same in both, to compare runs on machines of different speeds.
     for (const char* name : {"road_reflection", "road", "terrain"})
       row[std::string(name) + "_ms"] = passes.value(name, 0.0);
+    // Where the near road is drawn at half size and brought in, and the far road whole (ROAD on
+    // llvmpipe): the three passes.
+    if (passes.contains("road_layer")) {
+      double sum = 0.0;
+      for (const char* name : {"road_layer", "road_composite", "road_far"}) {
+        row[std::string(name) + "_ms"] = passes.value(name, 0.0);
+        sum += passes.value(name, 0.0);
+      }
+      row["road_ms"] = sum;
+    }
     row["wet_road_in_frame_ms"] =
         added_in_frame_ms(scenario, spec, frames, warm_s, [&](const sim::SceneState& state) {
           return std::pair{road(state, 0.3), road(state, 0.0)};
@@ -610,39 +620,99 @@ std::vector<sim::ViewSpec> demo_views() {
           sim::view_spec(sim::View::kRoad, 640, 360)};
 }
 
-// The pipeline with the step's helper and without it (FrameScheduler's step_helper), `pairs` pairs
-// in turn in this one process: the machine's speed drifts by a fifth from one process to the next
-// and over a minute, more than the difference measured. Per pair: COCKPIT at `spec` pipelined and
-// in real time, and the demo's session in real time; the medians each way and of the pairs' ratios.
-json measure_step_helper_pairs(const sim::Scenario& scenario, const sim::ViewSpec& spec,
-                               const std::vector<sim::ViewSpec>& demo, int pairs, int frames,
-                               double realtime_s, double warm_s) {
-  std::map<std::string, std::array<std::vector<double>, 2>> runs;  // [with, without]
+// Two settings measured in turn, `pairs` pairs in this one process: the machine's speed drifts by
+// a fifth from one process to the next and over a minute, more than the differences measured.
+// `use(k)` puts setting k (0 or 1) in place; `measure` adds its figures by name. Per figure: each
+// setting's values and median, and the median of the pairs' ratios (the first over the second).
+json measure_in_turn(int pairs, const std::array<std::string, 2>& names,
+                     const std::function<void(int)>& use,
+                     const std::function<void(std::map<std::string, double>&)>& measure) {
+  std::map<std::string, std::array<std::vector<double>, 2>> runs;
   for (int k = 0; k < pairs; ++k) {
-    for (const bool with : {true, false}) {
-      g_step_helper = with;
-      auto into = [&](const char* name) -> std::vector<double>& { return runs[name][!with]; };
-      into("pipelined_fps")
-          .push_back(measure_pipeline(scenario, spec, frames, 3, warm_s)["fps"].get<double>());
-      const json realtime = measure_realtime(scenario, {spec}, realtime_s, warm_s);
-      into("realtime_fps").push_back(realtime["fps"].get<double>());
-      into("realtime_latency_frames").push_back(realtime["latency_frames"].get<double>());
-      const json d = measure_realtime(scenario, demo, realtime_s, warm_s);
-      into("demo_fps").push_back(d["fps"].get<double>());
-      into("demo_latency_frames").push_back(d["latency_frames"].get<double>());
+    for (int setting : {0, 1}) {
+      use(setting);
+      std::map<std::string, double> figures;
+      measure(figures);
+      for (const auto& [name, value] : figures) runs[name][setting].push_back(value);
     }
   }
-  g_step_helper = true;
   json j = {{"pairs", pairs}};
   for (const auto& [name, both] : runs) {
     std::vector<double> ratios;
-    for (std::size_t k = 0; k < both[0].size(); ++k) ratios.push_back(both[0][k] / both[1][k]);
-    j[name] = {{"with_helper", both[0]},
-               {"without", both[1]},
-               {"median_with", median(both[0])},
-               {"median_without", median(both[1])},
+    for (std::size_t k = 0; k < std::min(both[0].size(), both[1].size()); ++k)
+      ratios.push_back(both[1][k] != 0.0 ? both[0][k] / both[1][k] : 0.0);
+    j[name] = {{names[0], both[0]},
+               {names[1], both[1]},
+               {"median_" + names[0], median(both[0])},
+               {"median_" + names[1], median(both[1])},
                {"median_ratio", median(ratios)}};
   }
+  return j;
+}
+
+// The pipeline with the step's helper and without it (FrameScheduler's step_helper), in turn. Per
+// pair: COCKPIT at `spec` pipelined and in real time, and the demo's session in real time.
+json measure_step_helper_pairs(const sim::Scenario& scenario, const sim::ViewSpec& spec,
+                               const std::vector<sim::ViewSpec>& demo, int pairs, int frames,
+                               double realtime_s, double warm_s) {
+  json j = measure_in_turn(
+      pairs, {"with_helper", "without"}, [](int k) { g_step_helper = k == 0; },
+      [&](std::map<std::string, double>& f) {
+        f["pipelined_fps"] = measure_pipeline(scenario, spec, frames, 3, warm_s)["fps"];
+        const json realtime = measure_realtime(scenario, {spec}, realtime_s, warm_s);
+        f["realtime_fps"] = realtime["fps"];
+        f["realtime_latency_frames"] = realtime["latency_frames"];
+        const json d = measure_realtime(scenario, demo, realtime_s, warm_s);
+        f["demo_fps"] = d["fps"];
+        f["demo_latency_frames"] = d["latency_frames"];
+      });
+  g_step_helper = true;
+  return j;
+}
+
+// The drive at `warm_s` and settled (`settled_s`, when puddles have formed and the traffic throws
+// spray), in turn: the demo's session in real time, and each pass of its views.
+json measure_settled_pairs(const sim::Scenario& scenario, const std::vector<sim::ViewSpec>& demo,
+                           int pairs, int frames, double realtime_s, double warm_s,
+                           double settled_s) {
+  double drive_s = warm_s;
+  json j = measure_in_turn(
+      pairs, {"settled", "early"}, [&](int k) { drive_s = k == 0 ? settled_s : warm_s; },
+      [&](std::map<std::string, double>& f) {
+        const json d = measure_realtime(scenario, demo, realtime_s, drive_s);
+        f["demo_fps"] = d["fps"];
+        f["demo_latency_frames"] = d["latency_frames"];
+        f["demo_cores_busy"] = d["cores_busy"];
+        for (const sim::ViewSpec& v : demo) {
+          const json passes = measure_passes(scenario, v, std::min(frames, 30), drive_s);
+          for (const auto& [name, ms] : passes.items())
+            f[std::string(sim::view_name(v.view)) + "." + name] = ms;
+        }
+      });
+  j["early_seconds"] = warm_s;
+  j["settled_seconds"] = settled_s;
+  return j;
+}
+
+// The chase view's road drawn at half size and brought in (RendererOptions::road_at_half), and
+// drawn whole, in turn: the demo's session in real time, and ROAD's road on the wet-road scene.
+json measure_road_at_half_pairs(const sim::Scenario& scenario,
+                                const std::vector<sim::ViewSpec>& demo, int pairs, int frames,
+                                double realtime_s, double warm_s) {
+  json j = measure_in_turn(
+      pairs, {"at_half", "whole"}, [](int k) { g_renderer.road_at_half = k == 0; },
+      [&](std::map<std::string, double>& f) {
+        const json d = measure_realtime(scenario, demo, realtime_s, warm_s);
+        f["demo_fps"] = d["fps"];
+        f["demo_latency_frames"] = d["latency_frames"];
+        const json road = measure_wet_road(scenario, std::min(frames, 30), std::min(warm_s, 2.0));
+        for (const json& row : road) {
+          const std::string view = row["view"];
+          f[view + ".road_ms"] = row["road_ms"];
+          f[view + ".wet_road_in_frame_ms"] = row["wet_road_in_frame_ms"];
+        }
+      });
+  g_renderer.road_at_half.reset();
   return j;
 }
 
@@ -694,12 +764,19 @@ int main(int argc, char** argv) {
   app.add_flag("--step-only", step_only,
                "only the step thread's tick behind a truck on a wet road (no GL)");
   app.add_flag("--demo-only", demo_only, "only the demo session (COCKPIT + ROAD, realtime)");
-  int step_helper_pairs = 0;
-  app.add_option("--step-helper-pairs", step_helper_pairs,
-                 "only: this many pairs of the pipeline with the step's helper and without, in "
-                 "turn in one process (COCKPIT at the first size, pipelined and realtime; the "
-                 "demo)")
-      ->check(CLI::Range(1, 50));
+  std::string in_turn;
+  int pairs = 3;
+  double settled_s = 120.0;
+  app.add_option("--in-turn", in_turn,
+                 "only: two settings measured in turn in one process, --pairs times: "
+                 "step-helper (the step with its helper thread and without: COCKPIT at the first "
+                 "size pipelined and realtime, the demo), settled (the drive at --warm-seconds and "
+                 "at --settled-seconds: the demo, its views' passes), road-at-half (the chase "
+                 "view's road at half size and whole: the demo, the wet road)")
+      ->check(CLI::IsMember({"step-helper", "settled", "road-at-half"}));
+  app.add_option("--pairs", pairs, "pairs for --in-turn")->check(CLI::Range(1, 50));
+  app.add_option("--settled-seconds", settled_s, "the settled drive's length (--in-turn settled)")
+      ->check(CLI::Range(0.0, 1200.0));
   app.add_flag("!--one-step-thread", g_step_helper,
                "the server's step on one thread, without its helper (the demo, the pipeline)");
   bool outputs = false;
@@ -747,16 +824,24 @@ int main(int argc, char** argv) {
     std::printf("%s\n", out.dump(2).c_str());
     return 0;
   }
-  if (step_helper_pairs > 0) {
-    int width = 0, height = 0;
-    if (sizes.empty() || std::sscanf(sizes[0].c_str(), "%dx%d", &width, &height) != 2) {
-      std::fprintf(stderr, "--step-helper-pairs needs a size\n");
-      return 2;
+  if (!in_turn.empty()) {
+    json& j = out["in_turn"];
+    if (in_turn == "step-helper") {
+      int width = 0, height = 0;
+      if (sizes.empty() || std::sscanf(sizes[0].c_str(), "%dx%d", &width, &height) != 2) {
+        std::fprintf(stderr, "--in-turn step-helper needs a size\n");
+        return 2;
+      }
+      j = measure_step_helper_pairs(scenario, sim::view_spec(sim::View::kCockpit, width, height),
+                                    demo_views(), pairs, frames, realtime_s, warm_s);
+      j["size"] = sizes[0];
+    } else if (in_turn == "settled") {
+      j = measure_settled_pairs(scenario, demo_views(), pairs, frames, realtime_s, warm_s,
+                                settled_s);
+    } else {
+      j = measure_road_at_half_pairs(scenario, demo_views(), pairs, frames, realtime_s, warm_s);
     }
-    out["step_helper_pairs"] =
-        measure_step_helper_pairs(scenario, sim::view_spec(sim::View::kCockpit, width, height),
-                                  demo_views(), step_helper_pairs, frames, realtime_s, warm_s);
-    out["step_helper_pairs"]["size"] = sizes[0];
+    j["what"] = in_turn;
     std::printf("%s\n", out.dump(2).c_str());
     return 0;
   }

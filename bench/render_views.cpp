@@ -26,6 +26,8 @@
 //   metres along it, in lane LANE (an OpenDRIVE lane id: negative to the right of the reference
 //   line, driving along it; positive against it), without the scene's traffic; --lift M PITCH: the
 //   car M metres over its place, pitched PITCH degrees nose down (to look at the roads from above).
+// --road-whole: the chase view's road drawn whole, not its near part at half size (the default on
+//   llvmpipe: RendererOptions::road_at_half).
 // --wipe: a wipe as a picture sequence: the scene's weather and drive at t_s with the wipers off
 //   for t_s seconds, then one SINGLE wipe; COCKPIT, WINDSHIELD (and --dash) written before it,
 //   every sixth of the cycle through it, and after (wipe_K_*.png).
@@ -58,6 +60,9 @@
 
 namespace {
 
+// The renderer's options (--road-whole).
+downpour::render::RendererOptions g_options;
+
 using namespace downpour;
 
 using bench::NamedView;
@@ -89,7 +94,7 @@ int wipe_sequence(const std::string& out, std::uint64_t seed, sim::Update update
     views.push_back({"COCKPIT_dash", sim::view_spec(sim::View::kCockpit, width, height,
                                                     render::dash_camera_pose())});
   }
-  auto renderer = render::Renderer::create({});
+  auto renderer = render::Renderer::create(g_options);
   const int frames_per_picture = static_cast<int>(std::lround(cycle_s / 6.0 * 30.0));
   for (int k = 0; k <= 7; ++k) {
     const sim::SceneState& scene = simulation.state();
@@ -180,6 +185,8 @@ int main(int argc, char** argv) {
       fog = std::atof(argv[++i]);
     } else if (arg == "--no-relief") {
       relief = false;
+    } else if (arg == "--road-whole") {
+      g_options.road_at_half = false;
     } else if (arg == "--puddles") {
       puddles = true;
     } else if (arg == "--speed" && i + 1 < argc) {
@@ -196,7 +203,7 @@ int main(int argc, char** argv) {
                  " [--windshield N] [--blades A B] [--dash] [--measure FRAMES] [--wipe]"
                  " [--speed MPS] [--road-water FILM_MM [--puddles]] [--dry-after S]"
                  " [--spray-drive GAP_M ROAD_MM SECONDS] [--sun ALT AZ] [--cloud C] [--fog F]"
-                 " [--no-relief]\n");
+                 " [--no-relief] [--road-whole]\n");
     return 2;
   }
   const std::string out = positional[0];
@@ -307,7 +314,7 @@ int main(int argc, char** argv) {
   }
 
   const auto t0 = std::chrono::steady_clock::now();
-  auto renderer = render::Renderer::create({});
+  auto renderer = render::Renderer::create(g_options);
   const auto t1 = std::chrono::steady_clock::now();
   std::printf("renderer %s, created in %.0f ms\n", renderer->gl_renderer().c_str(),
               std::chrono::duration<double, std::milli>(t1 - t0).count());

@@ -18,6 +18,9 @@ out vec4 v_principal_dirs;
 // The road drawn in two parts, near and far of x metres from the camera: y = 1 keeps the near
 // part, -1 the far (the same distance negated, so that the parts meet without a crack).
 uniform vec2 u_near_split;
+// And a plane that keeps a range of the view's depth (road_pass.hpp's RoadPart): xyz . world + w
+// at least 0 is kept; (0, 0, 0, 1) keeps all.
+uniform vec4 u_depth_clip;
 #endif
 #ifdef MESH_WHEELS
 // Wheel k's vertices [u_wheel_vertices[k].x, .y) turn about the axle through (x, z) =
@@ -71,5 +74,6 @@ void main() {
   gl_ClipDistance[0] = dot(frame.clip_plane.xyz, world.xyz) + frame.clip_plane.w;
 #ifdef MESH_CURVATURE
   gl_ClipDistance[1] = u_near_split.y * (u_near_split.x - distance(world.xyz, frame.camera_pos.xyz));
+  gl_ClipDistance[2] = dot(u_depth_clip.xyz, world.xyz) + u_depth_clip.w;
 #endif
 }

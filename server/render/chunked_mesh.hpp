@@ -13,6 +13,7 @@
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include "server/model/mesh_data.hpp"
 #include "server/render/gl/gl_objects.hpp"
@@ -37,6 +38,12 @@ class ChunkedMesh {
   // one call. A chunk outside [from_m, to_m) counts as not drawn for its neighbours' skirts.
   void draw_visible(const glm::mat4& view_proj, const glm::vec3& camera,
                     float distance_scale = 1.0f, float from_m = 0.0f, float to_m = 1e30f) const;
+  // Where on the screen the chunks that draw_visible() would draw may cover, up to max_w of the
+  // view's depth (view_proj's w): their boxes' rectangle in normalized device coordinates,
+  // (x0, y0, x1, y1), clipped to the screen; x1 < x0 where none.
+  glm::vec4 screen_bounds(const glm::mat4& view_proj, const glm::vec3& camera,
+                          float distance_scale = 1.0f, float from_m = 0.0f, float to_m = 1e30f,
+                          float max_w = 1e30f) const;
   // The triangles draw_visible() would draw (for tests and benchmarks).
   std::size_t visible_triangles(const glm::mat4& view_proj, const glm::vec3& camera) const;
 
@@ -46,6 +53,10 @@ class ChunkedMesh {
     std::uint32_t count = 0;
   };
   void build(const std::vector<std::vector<MeshData>>& chunks, const SkirtedChunks* skirted);
+  struct Chunk;
+  // The level a chunk is drawn at, as draw_visible() says, or -1.
+  int level_for(const Chunk& chunk, const glm::mat4& view_proj, const glm::vec3& camera,
+                float distance_scale, float from_m, float to_m) const;
   // Calls fn with each range of indices to draw: the visible chunks' surfaces at their levels,
   // and the skirts between two of them drawn at different levels.
   template <typename Fn>

@@ -87,6 +87,14 @@ constexpr ResourceInfo kResources[] = {
      .name = "client image",
      .texture_unit = texture_unit::kClientImage,
      .from_frame = true},
+    // Alpha 0 and the far plane (0, reversed-Z) where no road is; its depth at its own unit
+    // (kRoadLayerDepth).
+    {.resource = R::kRoadLayer,
+     .name = "road layer",
+     .texture_unit = texture_unit::kRoadLayer,
+     .scale = kRoadLayerScale,
+     .depth_from = R::kRoadLayer,
+     .linear_depth = true},
 };
 static_assert(std::size(kResources) == kResourceCount);
 constexpr bool in_order() {

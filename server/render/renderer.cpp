@@ -217,6 +217,10 @@ struct Renderer::Impl {
         texture = r.transient(res).colour.texture;
         glBindTextureUnit(texture_unit::kReflectionDepth, r.transient(res).depth.texture);
         break;
+      case Resource::kRoadLayer:
+        texture = r.transient(res).colour.texture;
+        glBindTextureUnit(texture_unit::kRoadLayerDepth, r.transient(res).depth.texture);
+        break;
       case Resource::kGlassSurface:
         session.upload_glass_surface(f.water().surface);
         return;  // bound to their units there
@@ -383,7 +387,9 @@ struct Renderer::Impl {
       });
     }
     timed(pass->decl().name, [&] { run_pass(*pass, frame, s, v.resources); });
-    if (pass == passes.road) view_drew_relief = passes.road->drew_relief();
+    if (pass == passes.road || pass == passes.road_layer)
+      view_drew_relief = static_cast<const RoadPass*>(pass)->drew_relief();
+    if (pass == passes.road_far) view_drew_relief |= passes.road_far->drew_relief();
     // The glass without its water keeps its blades.
     if (v.wants_clean && pass == static_cast<Pass*>(passes.glass_composite) &&
         pass->wanted(frame)) {
@@ -403,8 +409,9 @@ Renderer::~Renderer() = default;
 std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   auto impl = std::make_unique<Impl>();
   impl->context = EglContext::create(options.platform);
-  if (impl->context->renderer().find("llvmpipe") != std::string::npos ||
-      impl->context->renderer().find("softpipe") != std::string::npos) {
+  const bool cpu_rasterizer = impl->context->renderer().find("llvmpipe") != std::string::npos ||
+                              impl->context->renderer().find("softpipe") != std::string::npos;
+  if (cpu_rasterizer) {
     impl->min_glass_layer_scale = 2;
     impl->glass_layer_widening = 1.375;
   }
@@ -433,7 +440,8 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   impl->block = std::make_unique<FrameBlockBuffer>();
   impl->lamps = std::make_unique<FrameLamps>();
   impl->environment_programs = std::make_unique<EnvironmentPrograms>();
-  impl->passes = make_view_passes(*impl->shared, *impl->block, *impl->lamps, smoothing);
+  impl->passes = make_view_passes(*impl->shared, *impl->block, *impl->lamps, smoothing,
+                                  options.road_at_half.value_or(cpu_rasterizer));
   if (glGetError() != GL_NO_ERROR) throw std::runtime_error("GL error while creating the renderer");
   return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
 }
@@ -445,7 +453,11 @@ void Renderer::set_spray_smoothing(SpraySmoothing smoothing) {
   impl_->passes.spray_smooth->set_smoothing(smoothing);
 }
 SpraySmoothing Renderer::spray_smoothing() const { return impl_->passes.spray_smooth->smoothing(); }
-void Renderer::set_relief_shadows(bool on) { impl_->passes.road->set_relief_shadows(on); }
+void Renderer::set_relief_shadows(bool on) {
+  impl_->passes.road->set_relief_shadows(on);
+  impl_->passes.road_layer->set_relief_shadows(on);
+  impl_->passes.road_far->set_relief_shadows(on);
+}
 void Renderer::set_lamps(bool on) { impl_->lamps_on = on; }
 void Renderer::set_spray_in_mirror(bool on) { impl_->passes.spray_mirror->set_on(on); }
 bool Renderer::last_drew_relief() const { return impl_->view_drew_relief; }

@@ -23,6 +23,9 @@ namespace downpour::render {
 struct RendererOptions {
   EglPlatformChoice platform = EglPlatformChoice::kAuto;
   SpraySmoothing spray_smoothing = SpraySmoothing::kPlaneFit;
+  // The chase view's road drawn at half size and brought in (view_passes.hpp): by default where
+  // the renderer is a CPU rasterizer (llvmpipe), which pays for every pixel it shades.
+  std::optional<bool> road_at_half = std::nullopt;
 };
 
 struct PassTiming {

@@ -39,13 +39,18 @@ enum class Resource : std::uint8_t {
   // A client-background view's picture and its depth (sim::ClientImage), uploaded on first read
   // where new.
   kClientImage,
+  // The road drawn at half the view's size with its depth (the road's own), for a composite to
+  // bring into the view (road_pass.hpp): on a CPU rasterizer, where the road's shading is the
+  // dearest of a chase view's passes.
+  kRoadLayer,
 };
-inline constexpr std::size_t kResourceCount = 13;
+inline constexpr std::size_t kResourceCount = 14;
 
 inline constexpr int kNotTransient = -1;
 inline constexpr int kGlassLayerSize = 0;
 inline constexpr int kSprayLayerScale = 3;      // the spray layer: a third of the view each way
 inline constexpr int kRoadReflectionScale = 4;  // the road reflection: a quarter
+inline constexpr int kRoadLayerScale = 2;       // the road's layer: half
 
 inline constexpr int kSprayHazeOverLayer = 2;  // the spray's haze: half the layer each way
 
@@ -70,6 +75,7 @@ struct ResourceInfo {
   // The depth attached to a transient's framebuffer: its own (this resource), another
   // transient's of the same size (the spray's mask, for the tests against it), or none.
   std::optional<Resource> depth_from = std::nullopt;
+  bool linear_depth = false;  // its own depth read with bilinear filtering, else the nearest
   // What a transient holds before the first pass of a frame draws into it (its own depth too).
   std::array<float, 4> clear_colour = {0.0f, 0.0f, 0.0f, 0.0f};
   float clear_depth = 0.0f;

@@ -25,7 +25,7 @@
 namespace downpour::render {
 
 ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
-                            const FrameLamps& lamps, SpraySmoothing smoothing) {
+                            const FrameLamps& lamps, SpraySmoothing smoothing, bool road_at_half) {
   ViewPasses p;
   auto own = [&p](auto pass) {
     auto* raw = pass.get();
@@ -37,6 +37,14 @@ ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
   Pass* street_lights = own(std::make_unique<StreetLightPass>(shared));
   p.road = own(std::make_unique<RoadPass>(shared));
   Pass* road = p.road;
+  p.road_layer = own(std::make_unique<RoadPass>(shared, RoadPart::kNearInLayer));
+  p.road_far = own(std::make_unique<RoadPass>(shared, RoadPart::kFar));
+  const std::vector<Pass*> chase_road =
+      road_at_half
+          ? std::vector<Pass*>{p.road_layer,
+                               own(std::make_unique<RoadCompositePass>(shared, *p.road_layer)),
+                               p.road_far}
+          : std::vector<Pass*>{road};
   Pass* terrain = own(std::make_unique<TerrainPass>(shared));
   Pass* sky = own(std::make_unique<SkyPass>(shared));
   Pass* glow = own(std::make_unique<LampGlowPass>(shared));
@@ -83,7 +91,8 @@ ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
       then(then({cockpit, vehicles, street_lights, road, terrain, sky, glow, rain}, spray),
            {glass_water_mask, glass_water, glass_composite});
   frame[road_view] = {p.lamp_map, p.reflection};
-  views[road_view] = then({vehicles, street_lights, road, terrain, sky, glow, rain}, spray);
+  views[road_view] =
+      then(then(then({vehicles, street_lights}, chase_road), {terrain, sky, glow, rain}), spray);
   views[static_cast<int>(sim::View::kWindshield)] = {windshield};
   // The rain layer alone from the driver's eye: the scene for its depth alone (no lamp map, no
   // mirror), then black, then rain and spray.

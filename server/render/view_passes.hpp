@@ -47,6 +47,9 @@ struct ViewPasses {
   RoadReflectionPass* reflection = nullptr;
   SprayMirrorPass* spray_mirror = nullptr;
   RoadPass* road = nullptr;
+  // The near road at half size and the far road (ROAD, where the renderer asks for them).
+  RoadPass* road_layer = nullptr;
+  RoadPass* road_far = nullptr;
   RainPass* rain = nullptr;
   SprayPass* spray = nullptr;
   SpraySmoothPass* spray_smooth = nullptr;
@@ -54,7 +57,9 @@ struct ViewPasses {
 
 // Makes every pass and the views' lists; throws std::logic_error where a list breaks the pass
 // contract.
+// road_at_half: the chase view (ROAD) draws its road into the road's layer at half its size and
+// brings that in (RoadPass, RoadCompositePass), where shading costs for every pixel (llvmpipe).
 ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
-                            const FrameLamps& lamps, SpraySmoothing smoothing);
+                            const FrameLamps& lamps, SpraySmoothing smoothing, bool road_at_half);
 
 }  // namespace downpour::render

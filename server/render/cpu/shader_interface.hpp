@@ -68,7 +68,10 @@ namespace downpour::render {
   X(kSprayMirrorHaze, 25, sampler2D, spray_mirror_haze_tex,                                        \
     "the spray's haze seen in the road's mirror: r optical depth, g that times distance (m)")      \
   X(kModelTexture, 26, sampler2DArray, model_tex,                                                  \
-    "the model being drawn's base-colour textures, a layer each (sRGB, mipmapped)")
+    "the model being drawn's base-colour textures, a layer each (sRGB, mipmapped)")                \
+  X(kRoadLayer, 27, sampler2D, road_layer_tex,                                                     \
+    "the road at half the view's size (display-encoded), alpha 1 where drawn (road_pass.hpp)")     \
+  X(kRoadLayerDepth, 28, sampler2D, road_layer_depth_tex, "its depth (reversed-Z)")
 
 // The per-frame uniform block: X(GLSL type, name, comment). Every field is a vec4 or a mat4, so
 // the C++ struct below has the std140 layout as it is.

@@ -33,11 +33,11 @@ struct RenderState {
   // Depths beyond the near and far planes clamped to them rather than clipped (GL_DEPTH_CLAMP).
   bool depth_clamp = false;
   // Bit i: gl_ClipDistance[i] clips (0: the road reflection's plane; 1: the split between the near
-  // road, drawn with relief shadows, and the rest).
+  // road, drawn with relief shadows, and the rest; 2: the road's part by the view's depth).
   std::uint8_t clip_distances = 0;
   bool program_point_size = false;  // the vertex shader sets gl_PointSize
 };
-inline constexpr int kClipDistances = 2;
+inline constexpr int kClipDistances = 3;
 
 // Sets GL's depth test, depth writes, blending, colour writes, depth clamp, clip distances and
 // point size to `state`. Render thread only.

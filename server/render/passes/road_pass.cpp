@@ -5,6 +5,7 @@
 
 #include <glm/trigonometric.hpp>
 
+#include "server/render/cpu/camera.hpp"
 #include "server/render/cpu/light_set.hpp"
 #include "server/render/cpu/relief.hpp"
 #include "server/render/world.hpp"
@@ -27,7 +28,18 @@ constexpr float kBeamsReachRoadM = 4.0f;
 
 }  // namespace
 
-RoadPass::RoadPass(SharedResources& shared) : reliefs_(shared.reliefs) {
+RoadPass::RoadPass(SharedResources& shared, RoadPart part)
+    : decl_{part == RoadPart::kNearInLayer ? "road_layer"
+            : part == RoadPart::kFar       ? "road_far"
+                                           : "road",
+            {Resource::kRoadWater, Resource::kRoadReflection, Resource::kLampMap},
+            part == RoadPart::kNearInLayer
+                ? std::vector<Resource>{Resource::kRoadLayer}
+                : std::vector<Resource>{Resource::kViewColour, Resource::kViewDepth},
+            {DepthTest::kNearer, true, Blend::kOff, true, false, 0b110}},
+      part_(part),
+      scale_(part == RoadPart::kNearInLayer ? kRoadLayerScale : 1),
+      reliefs_(shared.reliefs) {
   const char* const files[kVariants] = {
       "road.frag",        "road_mirror.frag",        "road_ripples.frag",
       "road_relief.frag", "road_mirror_relief.frag", "road_ripples_relief.frag"};
@@ -39,6 +51,7 @@ RoadPass::RoadPass(SharedResources& shared) : reliefs_(shared.reliefs) {
     programs_[p].uniform("u_model").set(glm::mat4(1.0f));
     mean_lit_[p] = programs_[p].uniform("u_relief_mean_lit");
     near_split_[p] = programs_[p].uniform("u_near_split");
+    depth_clip_[p] = programs_[p].uniform("u_depth_clip");
     if (p % kVariants < 3) continue;  // (the relief's)
     programs_[p].uniform("u_horizon_directions").set(shared.horizon_directions);
     programs_[p]
@@ -47,17 +60,30 @@ RoadPass::RoadPass(SharedResources& shared) : reliefs_(shared.reliefs) {
   }
 }
 
-float RoadPass::relief_reach_m(const FrameContext& frame) {
+namespace {
+
+// The pixel angle of a view's rows (rad).
+float pixel_rad(const FrameContext& frame) {
+  return 2.0f * std::tan(glm::radians(frame.camera.fov_y_deg) * 0.5f) /
+         static_cast<float>(std::max(frame.spec.height, 1));
+}
+
+}  // namespace
+
+float RoadPass::relief_reach_m(const FrameContext& frame, int scale) {
   // A pixel's footprint on the road, d away from a camera h over it, for a pixel angle a, is
   // d a sqrt(1 + d^2 / h^2) along the view: about d^2 a / h where it is long. The setts' shadows
   // fade out from 4 cm (road_surface.glsl), reached at d = sqrt(0.04 h / a); a tenth further for
   // safety (the shader's footprint, the sum of two derivatives, is the longer one, and the split
   // measures d from the camera, not along the ground: both only bring the fade nearer).
-  const float pixel_rad = 2.0f * std::tan(glm::radians(frame.camera.fov_y_deg) * 0.5f) /
-                          static_cast<float>(std::max(frame.spec.height, 1));
+  const float pixel = pixel_rad(frame) * static_cast<float>(scale);
   const float height = std::max(
       frame.camera.position.z - static_cast<float>(frame.scene.vehicle.position_m.z), 0.5f);
-  return 1.1f * std::sqrt(kSettsResolvedToM * height / pixel_rad);
+  return 1.1f * std::sqrt(kSettsResolvedToM * height / pixel);
+}
+
+float RoadPass::layer_split_m(const FrameContext& frame) {
+  return kLayerTexelM / (static_cast<float>(kRoadLayerScale) * pixel_rad(frame));
 }
 
 void RoadPass::execute(const FrameContext& frame, const FrameResources& resources) {
@@ -72,7 +98,7 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
   // resolves them: the beams reach the road some metres ahead of the car, beyond the near road of
   // the driver's eye (under the bonnet) and of the chase camera, so those views skip it (it cost
   // the chase view 2 ms for nothing to see); a camera nearer to them draws it.
-  const float reach = relief_ ? relief_reach_m(frame) : 0.0f;
+  const float reach = relief_ ? relief_reach_m(frame, scale_) : 0.0f;
   const bool beams =
       frame.lights && std::any_of(frame.lights->begin(), frame.lights->end(), [&](const Light& l) {
         if (l.vehicle >= 0 || l.kind != LampKind::kHeadlight) return false;
@@ -86,6 +112,33 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
                                                                   : mirror ? 1
                                                                            : 0);
   const glm::mat4 view_proj = frame.camera.projection * frame.camera.view;
+  // (The far part's triangles are small, and llvmpipe shades whole blocks of pixels around each:
+  // the far part at the coarser levels from a quarter of their distances took 0.84-0.86 of the
+  // time in turn with the view's own, in a 640x360 ROAD.)
+  const float detail =
+      frame.detail_distance_scale * (part_ == RoadPart::kFar ? kFarDetailScale : 1.0f);
+  // This part's range of the chunks' distances (m from the camera), and its plane on the view's
+  // depth, d(p) = n . p + w0 (the view looks down its -z).
+  const glm::mat4& v = frame.camera.view;
+  const glm::vec3 n = -glm::vec3(v[0][2], v[1][2], v[2][2]);
+  const float w0 = -v[3][2];
+  const float split = layer_split_m(frame);
+  float from_m = 0.0f, to_m = 1e30f;
+  glm::vec4 depth_clip(0.0f, 0.0f, 0.0f, 1.0f);
+  if (part_ == RoadPart::kNearInLayer) {
+    const float end = split + kLayerOverlapM;
+    depth_clip = glm::vec4(-n, end - w0);
+    // A point at depth `end` lies this far at the view's corners.
+    const float tan_y = std::tan(glm::radians(frame.camera.fov_y_deg) * 0.5f);
+    const float tan_x = tan_y * static_cast<float>(frame.spec.width) /
+                        static_cast<float>(std::max(frame.spec.height, 1));
+    to_m = end * std::sqrt(1.0f + tan_x * tan_x + tan_y * tan_y);
+    screen_bounds_ =
+        frame.world->road.screen_bounds(view_proj, frame.camera.position, detail, 0.0f, to_m, end);
+  } else if (part_ == RoadPart::kFar) {
+    depth_clip = glm::vec4(n, w0 - split);
+    from_m = split;
+  }
   // Relief shadows: the near road with them, the rest without (llvmpipe would fetch the horizon
   // maps on every pixel of one draw, even where a branch skips them). Where a pixel covers many
   // of the relief's texels the shader takes their shadows' mean; the near part ends where that
@@ -95,18 +148,51 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
     const float elevation = std::asin(std::clamp(frame.atmosphere.sun_direction.z, 0.0f, 1.0f));
     mean_lit = {reliefs_->asphalt_horizon.mean_lit(elevation),
                 reliefs_->setts_horizon.mean_lit(elevation)};
+  }
+  const bool relief_here = drew_relief_ && reach > from_m;
+  if (relief_here) {
     programs_[plain + 3].use();
     mean_lit_[plain + 3].set(mean_lit);
     near_split_[plain + 3].set(glm::vec2(reach, 1.0f));
+    depth_clip_[plain + 3].set(depth_clip);
     // (Only the chunks that reach into the near part, and then those that reach beyond it.)
-    frame.world->road.draw_visible(view_proj, frame.camera.position, frame.detail_distance_scale,
-                                   0.0f, reach);
+    frame.world->road.draw_visible(view_proj, frame.camera.position, detail, from_m,
+                                   std::min(reach, to_m));
   }
+  if (relief_here && reach >= to_m) return;  // (the relief's draw held all of this part)
   programs_[plain].use();
   mean_lit_[plain].set(mean_lit);
-  near_split_[plain].set(glm::vec2(drew_relief_ ? reach : 0.0f, -1.0f));
-  frame.world->road.draw_visible(view_proj, frame.camera.position, frame.detail_distance_scale,
-                                 drew_relief_ ? reach : 0.0f);
+  near_split_[plain].set(glm::vec2(relief_here ? reach : 0.0f, -1.0f));
+  depth_clip_[plain].set(depth_clip);
+  frame.world->road.draw_visible(view_proj, frame.camera.position, detail,
+                                 relief_here ? std::max(reach, from_m) : from_m, to_m);
+}
+
+RoadCompositePass::RoadCompositePass(SharedResources& shared, const RoadPass& layer)
+    : shared_(shared),
+      layer_(layer),
+      program_("fullscreen.vert", "road_composite.frag"),
+      u_min_depth_(program_.uniform("u_min_depth")) {}
+
+void RoadCompositePass::execute(const FrameContext& frame, const FrameResources& r) {
+  // The rows and columns where the layer may hold road, a layer's texel wider each way (its
+  // bilinear neighbours).
+  const glm::vec4 b = layer_.screen_bounds();
+  if (b.z < b.x || b.w < b.y) return;
+  const glm::vec2 size(r.view_colour.width, r.view_colour.height);
+  const glm::ivec2 lo =
+      glm::max(glm::ivec2(glm::floor((glm::vec2(b) * 0.5f + 0.5f) * size)) - kRoadLayerScale, 0);
+  const glm::ivec2 hi =
+      glm::min(glm::ivec2(glm::ceil((glm::vec2(b.z, b.w) * 0.5f + 0.5f) * size)) + kRoadLayerScale,
+               glm::ivec2(size));
+  if (hi.x <= lo.x || hi.y <= lo.y) return;
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(lo.x, lo.y, hi.x - lo.x, hi.y - lo.y);
+  program_.use();
+  // Up to the split, and a hundredth beyond it, under the far part (road_far): no pixel between.
+  u_min_depth_.set(reversed_z(frame.camera.near_m, 1.01f * RoadPass::layer_split_m(frame)));
+  shared_.fullscreen.draw();
+  glDisable(GL_SCISSOR_TEST);
 }
 
 }  // namespace downpour::render

@@ -284,5 +284,47 @@ TEST_P(RoadWaterGoldenTest, MatchesGoldenImage) {
 INSTANTIATE_TEST_SUITE_P(States, RoadWaterGoldenTest, ::testing::Values("dry", "wet", "puddles"),
                          [](const auto& info) { return std::string(info.param); });
 
+// The chase view's road drawn at half size and brought in (RendererOptions::road_at_half, the
+// default on llvmpipe) against the road drawn whole: at the tests' 320 x 180 (a 160 x 90 layer),
+// dry, drenched and with rippling puddles, the picture is the same but for the road's finer detail
+// (the asphalt's grain, the markings' edges); the car in front of the road hides it as before
+// (its pixels the same), and the road's edges do not darken (its mean luma the same). Each
+// renderer is made and closed in turn: a renderer's context is current on the thread it was made
+// on.
+class ChaseRoadAtHalfTest : public RoadWaterPassTest {
+ protected:
+  static void SetUpTestSuite() {}
+  static RgbaImage draw(bool at_half, const sim::SceneState& s) {
+    auto renderer = render::Renderer::create({.road_at_half = at_half});
+    return {kWidth, kHeight,
+            render_image(*renderer, view_spec(sim::View::kRoad, kWidth, kHeight), s)};
+  }
+};
+
+TEST_F(ChaseRoadAtHalfTest, ThePictureIsTheWholeRoadsButForItsFinestDetail) {
+  const sim::SceneState states[] = {scene(0.0, 0.0, false, 0.6), scene(6.0, 0.3, false, 0.8),
+                                    scene(6.0, 0.3, true, 0.8)};
+  const char* names[] = {"dry", "wet", "puddles"};
+  for (int k = 0; k < 3; ++k) {
+    const RgbaImage whole = draw(false, states[k]), half = draw(true, states[k]);
+    testing::write_png(::testing::TempDir() + "chase_road_whole_" + names[k] + ".png", whole);
+    testing::write_png(::testing::TempDir() + "chase_road_half_" + names[k] + ".png", half);
+    const double db = testing::psnr(whole, half);
+    // The car: its rear between 40% and 60% across, 45-62% down (red stands out of the road).
+    const int car_whole =
+        red_pixels(whole, kWidth * 2 / 5, kHeight * 45 / 100, kWidth * 3 / 5, kHeight * 62 / 100);
+    const int car_half =
+        red_pixels(half, kWidth * 2 / 5, kHeight * 45 / 100, kWidth * 3 / 5, kHeight * 62 / 100);
+    // The road: the lower third, where it fills the view.
+    const double luma_whole = testing::mean_luma(whole, 0, kHeight * 2 / 3, kWidth, kHeight);
+    const double luma_half = testing::mean_luma(half, 0, kHeight * 2 / 3, kWidth, kHeight);
+    std::printf("%s: PSNR %.1f dB; car's red pixels %d whole, %d at half; road's luma %.4f, %.4f\n",
+                names[k], db, car_whole, car_half, luma_whole, luma_half);
+    EXPECT_GT(db, 30.0) << names[k];
+    EXPECT_NEAR(car_half, car_whole, car_whole / 50 + 2) << names[k];
+    EXPECT_NEAR(luma_half, luma_whole, 0.01) << names[k];
+  }
+}
+
 }  // namespace
 }  // namespace downpour::render
