@@ -639,13 +639,14 @@ json measure_in_turn(int pairs, const std::array<std::string, 2>& names,
   json j = {{"pairs", pairs}};
   for (const auto& [name, both] : runs) {
     std::vector<double> ratios;
-    for (std::size_t k = 0; k < std::min(both[0].size(), both[1].size()); ++k)
-      ratios.push_back(both[1][k] != 0.0 ? both[0][k] / both[1][k] : 0.0);
+    for (std::size_t k = 0; k < std::min(both[0].size(), both[1].size()); ++k) {
+      if (both[1][k] != 0.0) ratios.push_back(both[0][k] / both[1][k]);
+    }
     j[name] = {{names[0], both[0]},
                {names[1], both[1]},
                {"median_" + names[0], median(both[0])},
                {"median_" + names[1], median(both[1])},
-               {"median_ratio", median(ratios)}};
+               {"median_ratio", ratios.empty() ? json(nullptr) : json(median(ratios))}};
   }
   return j;
 }

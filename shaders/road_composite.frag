@@ -6,11 +6,12 @@
 // drawn whole, takes over there); it takes the bilinear colour and depth of the texels around it
 // that hold road (both sampled bilinear, over the alpha).
 #include "common.glsl"
-uniform float u_min_depth;  // reversed-Z: the split's
+uniform float u_min_depth;     // reversed-Z: the split's
+uniform vec2 u_inv_viewport;  // 1 / the view's size (the layer spans it, rounded up to whole texels)
 out vec4 out_colour;
 
 void main() {
-  vec2 uv = gl_FragCoord.xy / vec2(2 * textureSize(road_layer_tex, 0));
+  vec2 uv = gl_FragCoord.xy * u_inv_viewport;
   vec4 c = textureLod(road_layer_tex, uv, 0.0);
   float depth = textureLod(road_layer_depth_tex, uv, 0.0).r / max(c.a, 1e-3);
   if (c.a < 0.5 || depth < u_min_depth) discard;

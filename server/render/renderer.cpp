@@ -455,8 +455,9 @@ void Renderer::set_spray_smoothing(SpraySmoothing smoothing) {
 SpraySmoothing Renderer::spray_smoothing() const { return impl_->passes.spray_smooth->smoothing(); }
 void Renderer::set_relief_shadows(bool on) {
   impl_->passes.road->set_relief_shadows(on);
-  impl_->passes.road_layer->set_relief_shadows(on);
-  impl_->passes.road_far->set_relief_shadows(on);
+  for (RoadPass* part : {impl_->passes.road_layer, impl_->passes.road_far}) {
+    if (part) part->set_relief_shadows(on);
+  }
 }
 void Renderer::set_lamps(bool on) { impl_->lamps_on = on; }
 void Renderer::set_spray_in_mirror(bool on) { impl_->passes.spray_mirror->set_on(on); }

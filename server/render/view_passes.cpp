@@ -37,14 +37,14 @@ ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
   Pass* street_lights = own(std::make_unique<StreetLightPass>(shared));
   p.road = own(std::make_unique<RoadPass>(shared));
   Pass* road = p.road;
-  p.road_layer = own(std::make_unique<RoadPass>(shared, RoadPart::kNearInLayer));
-  p.road_far = own(std::make_unique<RoadPass>(shared, RoadPart::kFar));
-  const std::vector<Pass*> chase_road =
-      road_at_half
-          ? std::vector<Pass*>{p.road_layer,
-                               own(std::make_unique<RoadCompositePass>(shared, *p.road_layer)),
-                               p.road_far}
-          : std::vector<Pass*>{road};
+  // (Made only where drawn: each is twelve programs to compile.)
+  std::vector<Pass*> chase_road = {road};
+  if (road_at_half) {
+    p.road_layer = own(std::make_unique<RoadPass>(shared, RoadPart::kNearInLayer));
+    p.road_far = own(std::make_unique<RoadPass>(shared, RoadPart::kFar));
+    chase_road = {p.road_layer, own(std::make_unique<RoadCompositePass>(shared, *p.road_layer)),
+                  p.road_far};
+  }
   Pass* terrain = own(std::make_unique<TerrainPass>(shared));
   Pass* sky = own(std::make_unique<SkyPass>(shared));
   Pass* glow = own(std::make_unique<LampGlowPass>(shared));

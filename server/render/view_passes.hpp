@@ -47,7 +47,8 @@ struct ViewPasses {
   RoadReflectionPass* reflection = nullptr;
   SprayMirrorPass* spray_mirror = nullptr;
   RoadPass* road = nullptr;
-  // The near road at half size and the far road (ROAD, where the renderer asks for them).
+  // The near road at half size and the far road (ROAD, where the renderer asks for them; else
+  // null).
   RoadPass* road_layer = nullptr;
   RoadPass* road_far = nullptr;
   RainPass* rain = nullptr;

@@ -106,7 +106,7 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
         const glm::vec2 lit = glm::vec2(l.position) + ahead * kBeamsReachRoadM;
         return glm::length(lit - glm::vec2(frame.camera.position)) < reach;
       });
-  drew_relief_ = relief_ && (std::max({sun.r, sun.g, sun.b}) > kReliefSunFrom || beams);
+  const bool relief_on = relief_ && (std::max({sun.r, sun.g, sun.b}) > kReliefSunFrom || beams);
   const std::size_t plain =
       static_cast<std::size_t>(lamps_build(frame)) * kVariants + (ripples  ? 2
                                                                   : mirror ? 1
@@ -114,9 +114,10 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
   const glm::mat4 view_proj = frame.camera.projection * frame.camera.view;
   // (The far part's triangles are small, and llvmpipe shades whole blocks of pixels around each:
   // the far part at the coarser levels from a quarter of their distances took 0.84-0.86 of the
-  // time in turn with the view's own, in a 640x360 ROAD.)
+  // time in turn with the view's own, in a 640x360 ROAD. The near part takes the same levels, so
+  // that both draw the same surface where they meet.)
   const float detail =
-      frame.detail_distance_scale * (part_ == RoadPart::kFar ? kFarDetailScale : 1.0f);
+      frame.detail_distance_scale * (part_ == RoadPart::kWhole ? 1.0f : kPartsDetailScale);
   // This part's range of the chunks' distances (m from the camera), and its plane on the view's
   // depth, d(p) = n . p + w0 (the view looks down its -z).
   const glm::mat4& v = frame.camera.view;
@@ -144,12 +145,14 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
   // of the relief's texels the shader takes their shadows' mean; the near part ends where that
   // holds everywhere.
   glm::vec2 mean_lit(1.0f);
-  if (drew_relief_) {
+  if (relief_on) {
     const float elevation = std::asin(std::clamp(frame.atmosphere.sun_direction.z, 0.0f, 1.0f));
     mean_lit = {reliefs_->asphalt_horizon.mean_lit(elevation),
                 reliefs_->setts_horizon.mean_lit(elevation)};
   }
-  const bool relief_here = drew_relief_ && reach > from_m;
+  // (This part's: the far part of a view whose relief ends before it draws none.)
+  const bool relief_here = relief_on && reach > from_m;
+  drew_relief_ = relief_here;
   if (relief_here) {
     programs_[plain + 3].use();
     mean_lit_[plain + 3].set(mean_lit);
@@ -172,7 +175,8 @@ RoadCompositePass::RoadCompositePass(SharedResources& shared, const RoadPass& la
     : shared_(shared),
       layer_(layer),
       program_("fullscreen.vert", "road_composite.frag"),
-      u_min_depth_(program_.uniform("u_min_depth")) {}
+      u_min_depth_(program_.uniform("u_min_depth")),
+      u_inv_viewport_(program_.uniform("u_inv_viewport")) {}
 
 void RoadCompositePass::execute(const FrameContext& frame, const FrameResources& r) {
   // The rows and columns where the layer may hold road, a layer's texel wider each way (its
@@ -191,6 +195,7 @@ void RoadCompositePass::execute(const FrameContext& frame, const FrameResources&
   program_.use();
   // Up to the split, and a hundredth beyond it, under the far part (road_far): no pixel between.
   u_min_depth_.set(reversed_z(frame.camera.near_m, 1.01f * RoadPass::layer_split_m(frame)));
+  u_inv_viewport_.set(1.0f / size);
   shared_.fullscreen.draw();
   glDisable(GL_SCISSOR_TEST);
 }

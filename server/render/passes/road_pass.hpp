@@ -22,7 +22,7 @@ namespace downpour::render {
 // road into the view ("road_far"). On llvmpipe the road's shading is most of a chase view's cost
 // (ROAD, 640x360, a wet road with puddles: 8.3 ms drawn whole, 1.5 ms of it with a shader that
 // does nothing), and most of the road's pixels are near: beyond where a layer's texel is
-// kLayerTexelM across (15.6 m in a 640x360 view) lies a tenth of ROAD's road. The near road's
+// kLayerTexelM across (17.3 m in a 640x360 ROAD) lies a tenth of its road. The near road's
 // detail is what the layer's texels resolve (the shader's footprints, fwidth, are the layer's);
 // the far road's thin markings and edges, which a layer's texel would break into steps and beads,
 // keep the view's pixels.
@@ -36,8 +36,8 @@ class RoadPass final : public Pass {
   static constexpr float kLayerTexelM = 0.1f;
   // The near part reaches this much further, for the composite's bilinear texels at its end.
   static constexpr float kLayerOverlapM = 2.0f;
-  // The far part's geometry at the coarser levels from this many times nearer (ChunkedMesh).
-  static constexpr float kFarDetailScale = 4.0f;
+  // The parts' geometry at the coarser levels from this many times nearer (ChunkedMesh).
+  static constexpr float kPartsDetailScale = 4.0f;
   const PassDecl& decl() const override { return decl_; }
   void execute(const FrameContext& frame, const FrameResources& resources) override;
   // Relief shadows on (the default) or off, for comparisons; off by themselves wherever direct
@@ -93,7 +93,7 @@ class RoadCompositePass final : public Pass {
   SharedResources& shared_;
   const RoadPass& layer_;
   ShaderProgram program_;
-  Uniform u_min_depth_;
+  Uniform u_min_depth_, u_inv_viewport_;
 };
 
 }  // namespace downpour::render
