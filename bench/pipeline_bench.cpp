@@ -203,10 +203,11 @@ json measure_step_thread(const sim::Scenario& scenario, int ticks, double warm_s
     sim::Simulation simulation;
     sim::WorkerThread* helper;
     std::map<std::string, std::vector<double>> parts;
+    std::map<std::string, std::vector<double>> counts;
   };
   std::array<Run, 2> runs{
-      Run{sim::Simulation(scenario.seed, scenario.at(0.0), config), &helper, {}},
-      Run{sim::Simulation(scenario.seed, scenario.at(0.0), config), nullptr, {}}};
+      Run{sim::Simulation(scenario.seed, scenario.at(0.0), config), &helper, {}, {}},
+      Run{sim::Simulation(scenario.seed, scenario.at(0.0), config), nullptr, {}, {}}};
   constexpr int kBlock = 30;
   const int warm_ticks = static_cast<int>(warm_s * scenario.fps);
   for (int block = 0; block < warm_ticks + ticks; block += kBlock) {
@@ -219,6 +220,7 @@ json measure_step_thread(const sim::Scenario& scenario, int ticks, double warm_s
         simulation.advance(dt, run.helper);
         if (!measured) continue;
         auto& parts = run.parts;
+        auto& counts = run.counts;
         parts["tick"].push_back(ms_between(t0, Clock::now()));
         const sim::AdvanceTiming& a = simulation.last_advance_timing();
         parts["water"].push_back(a.water_ms);
@@ -229,12 +231,18 @@ json measure_step_thread(const sim::Scenario& scenario, int ticks, double warm_s
         parts["spray"].push_back(a.spray_ms);
         parts["spray_image"].push_back(a.spray_image_ms);
         parts["waited"].push_back(a.waited_ms);
+        // The glass's water, whose particles (by the blades) set the water step's cost.
+        counts["glass_drops"].push_back(static_cast<double>(simulation.water().drops().size()));
+        counts["glass_particles"].push_back(
+            static_cast<double>(simulation.water().particles().size()));
       }
     }
   }
   json j = {{"ticks", ticks}, {"truck_gap_m", gap_m}, {"road_film_mm", film_mm}};
   for (const auto& [name, ms] : runs[0].parts)
     j[name + "_ms"] = {{"median", median(ms)}, {"p90", percentile(ms, 0.9)}};
+  for (const auto& [name, n] : runs[0].counts)
+    j[name] = {{"median", median(n)}, {"p90", percentile(n, 0.9)}};
   const std::vector<double>& alone = runs[1].parts["tick"];
   j["tick_one_thread_ms"] = {{"median", median(alone)}, {"p90", percentile(alone, 0.9)}};
   j["spray_parcels"] = runs[0].simulation.spray().particles().size();
