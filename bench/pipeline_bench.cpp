@@ -19,6 +19,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -378,18 +379,18 @@ json measure_wet_road(const sim::Scenario& scenario, int frames, double warm_s) 
                        [&](const sim::SceneState& state) { return road(state, 0.3); });
     json row = {{"view", std::string(sim::view_name(view))}, {"size", "640x360"}};
     // Terrain, drawn the same in both, to compare runs on machines of different speeds.
-    for (const char* name : {"road_reflection", "road", "terrain"})
+    for (const char* name : {"road_reflection", "terrain"})
       row[std::string(name) + "_ms"] = passes.value(name, 0.0);
-    // Where the near road is drawn at half size and brought in, and the far road whole (ROAD on
-    // llvmpipe): the three passes.
-    if (passes.contains("road_layer")) {
-      double sum = 0.0;
-      for (const char* name : {"road_layer", "road_composite", "road_far"}) {
-        row[std::string(name) + "_ms"] = passes.value(name, 0.0);
-        sum += passes.value(name, 0.0);
-      }
-      row["road_ms"] = sum;
+    // The road's passes (on llvmpipe ROAD's are its near part, the composite and its far part),
+    // each drawn, and their sum.
+    double road_ms = 0.0;
+    for (std::string_view name : render::kRoadPassNames) {
+      const std::string key(name);
+      if (!passes.contains(key)) continue;
+      row[key + "_ms"] = passes[key];
+      road_ms += passes[key].get<double>();
     }
+    row["road_ms"] = road_ms;
     row["wet_road_in_frame_ms"] =
         added_in_frame_ms(scenario, spec, frames, warm_s, [&](const sim::SceneState& state) {
           return std::pair{road(state, 0.3), road(state, 0.0)};
@@ -628,6 +629,12 @@ std::vector<sim::ViewSpec> demo_views() {
           sim::view_spec(sim::View::kRoad, 640, 360)};
 }
 
+// The demo's figures that the comparisons below keep, from measure_realtime.
+void add_demo(const json& demo, std::map<std::string, double>& f) {
+  f["demo_fps"] = demo["fps"];
+  f["demo_latency_frames"] = demo["latency_frames"];
+}
+
 // Two settings measured in turn, `pairs` pairs in this one process: the machine's speed drifts by
 // a fifth from one process to the next and over a minute, more than the differences measured.
 // `use(k)` puts setting k (0 or 1) in place; `measure` adds its figures by name. Per figure: each
@@ -671,9 +678,7 @@ json measure_step_helper_pairs(const sim::Scenario& scenario, const sim::ViewSpe
         const json realtime = measure_realtime(scenario, {spec}, realtime_s, warm_s);
         f["realtime_fps"] = realtime["fps"];
         f["realtime_latency_frames"] = realtime["latency_frames"];
-        const json d = measure_realtime(scenario, demo, realtime_s, warm_s);
-        f["demo_fps"] = d["fps"];
-        f["demo_latency_frames"] = d["latency_frames"];
+        add_demo(measure_realtime(scenario, demo, realtime_s, warm_s), f);
       });
   g_step_helper = true;
   return j;
@@ -689,8 +694,7 @@ json measure_settled_pairs(const sim::Scenario& scenario, const std::vector<sim:
       pairs, {"settled", "early"}, [&](int k) { drive_s = k == 0 ? settled_s : warm_s; },
       [&](std::map<std::string, double>& f) {
         const json d = measure_realtime(scenario, demo, realtime_s, drive_s);
-        f["demo_fps"] = d["fps"];
-        f["demo_latency_frames"] = d["latency_frames"];
+        add_demo(d, f);
         f["demo_cores_busy"] = d["cores_busy"];
         for (const sim::ViewSpec& v : demo) {
           const json passes = measure_passes(scenario, v, std::min(frames, 30), drive_s);
@@ -711,9 +715,7 @@ json measure_road_at_half_pairs(const sim::Scenario& scenario,
   json j = measure_in_turn(
       pairs, {"at_half", "whole"}, [](int k) { g_renderer.road_at_half = k == 0; },
       [&](std::map<std::string, double>& f) {
-        const json d = measure_realtime(scenario, demo, realtime_s, warm_s);
-        f["demo_fps"] = d["fps"];
-        f["demo_latency_frames"] = d["latency_frames"];
+        add_demo(measure_realtime(scenario, demo, realtime_s, warm_s), f);
         const json road = measure_wet_road(scenario, std::min(frames, 30), std::min(warm_s, 2.0));
         for (const json& row : road) {
           const std::string view = row["view"];

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -72,8 +73,9 @@ int main(int argc, char** argv) {
         if (i < kWarmUp) continue;
         double sum = 0.0;
         for (const auto& p : renderer->last_pass_timings()) {
-          // (On llvmpipe ROAD's road is three passes: road_pass.hpp's parts.)
-          if (p.name.rfind("road", 0) == 0 && p.name != "road_reflection") sum += p.ms;
+          for (std::string_view road : render::kRoadPassNames) {
+            if (p.name == road) sum += p.ms;
+          }
         }
         road_ms[on].push_back(sum);
       }

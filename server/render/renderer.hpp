@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -27,6 +28,11 @@ struct RendererOptions {
   // the renderer is a CPU rasterizer (llvmpipe), which pays for every pixel it shades.
   std::optional<bool> road_at_half = std::nullopt;
 };
+
+// The passes that draw a view's road (PassTiming::name): the road whole, or ROAD's near part into
+// the road's layer, its composite and its far part (road_pass.hpp).
+inline constexpr std::array<std::string_view, 4> kRoadPassNames = {"road", "road_layer",
+                                                                   "road_composite", "road_far"};
 
 struct PassTiming {
   std::string name;

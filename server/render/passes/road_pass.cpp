@@ -8,6 +8,7 @@
 #include "server/render/cpu/camera.hpp"
 #include "server/render/cpu/light_set.hpp"
 #include "server/render/cpu/relief.hpp"
+#include "server/render/renderer.hpp"
 #include "server/render/world.hpp"
 
 namespace downpour::render {
@@ -29,9 +30,9 @@ constexpr float kBeamsReachRoadM = 4.0f;
 }  // namespace
 
 RoadPass::RoadPass(SharedResources& shared, RoadPart part)
-    : decl_{part == RoadPart::kNearInLayer ? "road_layer"
-            : part == RoadPart::kFar       ? "road_far"
-                                           : "road",
+    : decl_{std::string(kRoadPassNames[part == RoadPart::kNearInLayer ? 1
+                                       : part == RoadPart::kFar       ? 3
+                                                                      : 0]),
             {Resource::kRoadWater, Resource::kRoadReflection, Resource::kLampMap},
             part == RoadPart::kNearInLayer
                 ? std::vector<Resource>{Resource::kRoadLayer}
@@ -172,7 +173,11 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
 }
 
 RoadCompositePass::RoadCompositePass(SharedResources& shared, const RoadPass& layer)
-    : shared_(shared),
+    : decl_{std::string(kRoadPassNames[2]),
+            {Resource::kRoadLayer},
+            {Resource::kViewColour, Resource::kViewDepth},
+            {DepthTest::kNearer, true, Blend::kOff}},
+      shared_(shared),
       layer_(layer),
       program_("fullscreen.vert", "road_composite.frag"),
       u_min_depth_(program_.uniform("u_min_depth")),

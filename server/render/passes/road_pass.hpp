@@ -86,10 +86,7 @@ class RoadCompositePass final : public Pass {
   void execute(const FrameContext& frame, const FrameResources& resources) override;
 
  private:
-  const PassDecl decl_{"road_composite",
-                       {Resource::kRoadLayer},
-                       {Resource::kViewColour, Resource::kViewDepth},
-                       {DepthTest::kNearer, true, Blend::kOff}};
+  const PassDecl decl_;
   SharedResources& shared_;
   const RoadPass& layer_;
   ShaderProgram program_;
