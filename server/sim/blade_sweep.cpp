@@ -36,7 +36,11 @@ void BladeSweep::sweep(const WaterInputs& in, MeshModel& mesh, ParticleModel& mo
     };
     double along;
     for (ParticleModel::Particle& p : particles) {
-      if (swept(p.pos, rp, &along)) p.pos = pivot + along * d1 + (half + rp) * n1;
+      if (!swept(p.pos, rp, &along)) continue;
+      // Its gap ahead of the blade's edge before, kept: set on the edge, all that a fast blade
+      // passed in a step would land on one line, a knot the repulsion cannot untie in a step.
+      const double gap = std::max(0.0, glm::dot(n0, p.pos - pivot) - half - rp);
+      p.pos = pivot + along * d1 + (half + rp + gap) * n1;
     }
     // The swept sector's bounding box (the arc between the tips bulges out to the tip of the
     // middle direction, reached at length / cos(half the turn)), for a quick rejection.

@@ -1,6 +1,6 @@
-// The wiper blades on the water (seed 000, sections 1.2-1.3): a moving blade pushes
-// the particles it reaches to its leading edge and turns the mesh drops it touches into equal
-// particles. The test is continuous: a point ahead of the blade before the step and within reach
+// The wiper blades on the water (seed 000, sections 1.2-1.3): a moving blade carries the
+// particles it reaches ahead of its leading edge, each with the gap it had in front of the blade,
+// and turns the mesh drops it touches into equal particles. The test is continuous: a point ahead of the blade before the step and within reach
 // of it after was swept, however far the blade turned.
 #pragma once
 
