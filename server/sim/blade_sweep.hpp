@@ -1,11 +1,12 @@
-// The wiper blades on the water (seed 000, sections 1.2-1.3): a moving blade carries the
-// particles it reaches ahead of its leading edge, each with the gap it had in front of the blade,
-// and turns the mesh drops it touches into equal particles. The test is continuous: a point ahead of the blade before the step and within reach
-// of it after was swept, however far the blade turned.
+// The wiper blades on the water (seed 000, sections 1.2-1.3): a moving blade pushes the
+// particles it reaches ahead of its leading edge, stacked in the order they stood, and turns the
+// mesh drops it touches into equal particles. The test is continuous: a point ahead of the blade
+// before the step and within reach of it after was swept, however far the blade turned.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "server/sim/mesh_model.hpp"
 #include "server/sim/particle_model.hpp"
@@ -30,6 +31,13 @@ class BladeSweep {
   WaterConfig config_;
   RandomStream random_;
   std::array<double, 2> carried_{};
+  struct Swept {         // a particle a blade reached in a step (scratch)
+    std::int64_t strip;  // along the blade, a particle wide
+    double ahead;        // of the blade's edge before the step, mm
+    double along;        // along the blade after it, mm
+    std::uint32_t index;
+  };
+  std::vector<Swept> swept_;
   double wiped_off_ = 0.0;
 };
 
