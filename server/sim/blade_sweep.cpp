@@ -37,11 +37,12 @@ void BladeSweep::sweep(const WaterInputs& in, MeshModel& mesh, ParticleModel& mo
     };
     double along;
     // The particles it reached, by strips a particle wide along it, each strip's in the order they
-    // stood ahead of it.
+    // stood across it.
     swept_.clear();
     for (std::uint32_t i = 0; i < particles.size(); ++i) {
       if (!swept(particles[i].pos, rp, &along)) continue;
-      const double ahead = glm::dot(n0, particles[i].pos - pivot) - half;
+      // (Across the blade after the step: the order its edge meets them in, for any turn.)
+      const double ahead = glm::dot(n1, particles[i].pos - pivot);
       swept_.push_back(
           {static_cast<std::int64_t>(std::floor(along / (2.0 * rp))), ahead, along, i});
     }

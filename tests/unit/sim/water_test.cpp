@@ -210,18 +210,24 @@ TEST(WaterTest, ABladeStacksWhatItSweepsInTheOrderItStood) {
   place(200.0, 6.0);  // lone, 6 mm ahead: the blade, 10.5 mm on there, reaches it
   for (int k = 2; k >= 0; --k) place(300.0, 1.0 * k);  // added furthest first
   for (int k = 0; k < 15; ++k) place(400.0, 1.0 * k);
+  place(200.0, 12.0);  // 12 mm ahead where the blade moves 10.5: out of its reach
+  const glm::dvec2 unreached = particles.particles().back().pos;
   sweep.sweep(in, mesh, particles);
   const std::vector<ParticleModel::Particle>& p = particles.particles();
-  ASSERT_EQ(p.size(), 19u);
+  ASSERT_EQ(p.size(), 20u);
+  EXPECT_EQ(p.back().pos, unreached) << "what the blade did not reach stays";
   auto ahead = [&](std::size_t i) { return glm::dot(p[i].pos - pivot, left_normal(d1)) - half; };
-  for (std::size_t i = 0; i < p.size(); ++i) EXPECT_GE(ahead(i), r - 1e-6) << i;
+  for (std::size_t i = 0; i + 1 < p.size(); ++i) {
+    EXPECT_GE(ahead(i), r - 1e-6) << i;
+    EXPECT_NEAR(glm::dot(p[i].pos - pivot, d1), i == 0 ? 200.0 : i < 4 ? 300.0 : 400.0, 2.0) << i;
+  }
   EXPECT_NEAR(ahead(0), r, 1e-6) << "the lone one against the edge";
   EXPECT_NEAR(ahead(3), r, 1e-6) << "the nearest of three against the edge";
   EXPECT_NEAR(ahead(2), 3.0 * r, 1e-6) << "the next a particle's width ahead";
   EXPECT_NEAR(ahead(1), 5.0 * r, 1e-6) << "and the furthest";
-  for (std::size_t i = 5; i < p.size(); ++i) {
+  for (std::size_t i = 5; i + 1 < p.size(); ++i) {
     EXPECT_GT(ahead(i) - ahead(i - 1), 0.5) << "fifteen in their order, apart: " << i;
-    EXPECT_LE(ahead(i), region) << "inside the particles' region: " << i;
+    EXPECT_LE(ahead(i), region - r + 1e-6) << "wholly inside the particles' region: " << i;
   }
 }
 
