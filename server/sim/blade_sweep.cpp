@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <tuple>
 
 #include <glm/geometric.hpp>
 
@@ -42,14 +43,12 @@ void BladeSweep::sweep(const WaterInputs& in, MeshModel& mesh, ParticleModel& mo
     for (std::uint32_t i = 0; i < particles.size(); ++i) {
       if (!swept(particles[i].pos, rp, &along)) continue;
       // (Across the blade after the step: the order its edge meets them in, for any turn.)
-      const double ahead = glm::dot(n1, particles[i].pos - pivot);
+      const double across = glm::dot(n1, particles[i].pos - pivot);
       swept_.push_back(
-          {static_cast<std::int64_t>(std::floor(along / (2.0 * rp))), ahead, along, i});
+          {static_cast<std::int64_t>(std::floor(along / (2.0 * rp))), across, along, i});
     }
     std::sort(swept_.begin(), swept_.end(), [](const Swept& a, const Swept& b) {
-      return a.strip != b.strip   ? a.strip < b.strip
-             : a.ahead != b.ahead ? a.ahead < b.ahead
-                                  : a.index < b.index;
+      return std::tie(a.strip, a.across, a.index) < std::tie(b.strip, b.across, b.index);
     });
     // Each strip's stacked against the edge, the nearest touching it and each further one a
     // particle's width ahead of the last, as the blade pushing the first pushes the rest; a strip

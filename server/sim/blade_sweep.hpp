@@ -33,7 +33,7 @@ class BladeSweep {
   std::array<double, 2> carried_{};
   struct Swept {         // a particle a blade reached in a step (scratch)
     std::int64_t strip;  // along the blade, a particle wide
-    double ahead;        // across the blade after the step, mm
+    double across;       // across the blade after the step, towards its motion, mm
     double along;        // along the blade after it, mm
     std::uint32_t index;
   };
