@@ -1,8 +1,10 @@
 #include "server/sim/blade_sweep.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <tuple>
 
 #include <glm/geometric.hpp>
@@ -10,6 +12,32 @@
 #include "server/sim/water_inputs.hpp"
 
 namespace downpour::sim {
+
+namespace {
+
+// A convex polygon cut by half-planes: the box of a blade's step cut by its sweep's lines.
+struct Outline {
+  // A box cut four times has eight corners at most; the room to spare is for rounding.
+  std::array<glm::dvec2, 16> corners;
+  std::size_t count = 0;
+  // The part where dot(normal, p) >= offset. (Left whole where rounding would make more corners
+  // than there is room for: a polygon that holds the part holds what the part holds.)
+  void keep_where(glm::dvec2 normal, double offset) {
+    std::array<glm::dvec2, 16> kept;
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < count; ++k) {
+      if (n + 2 > kept.size()) return;
+      const glm::dvec2 p = corners[k], q = corners[(k + 1) % count];
+      const double fp = glm::dot(normal, p) - offset, fq = glm::dot(normal, q) - offset;
+      if (fp >= 0.0) kept[n++] = p;
+      if ((fp >= 0.0) != (fq >= 0.0)) kept[n++] = p + (q - p) * (fp / (fp - fq));
+    }
+    corners = kept;
+    count = n;
+  }
+};
+
+}  // namespace
 
 BladeSweep::BladeSweep(const WaterConfig& config, std::uint64_t seed)
     : config_(config), random_(seed, 3) {}
@@ -74,8 +102,26 @@ void BladeSweep::sweep(const WaterInputs& in, MeshModel& mesh, ParticleModel& mo
     const glm::dvec2 tip0 = pivot + d0 * length, tip1 = pivot + d1 * length;
     const glm::dvec2 lo = glm::min(glm::min(pivot, bulge), glm::min(tip0, tip1)) - half;
     const glm::dvec2 hi = glm::max(glm::max(pivot, bulge), glm::max(tip0, tip1)) + half;
-    const std::size_t n = drops.size();
-    for (std::size_t i = 0; i < n; ++i) {
+    // The drops that can pass both tests are those whose centres lie in that box grown by the
+    // largest radius and inside swept()'s four lines at that radius: a convex polygon, the box
+    // cut by each line in turn. (A hair wider all round: the cells it reaches are a superset,
+    // and each drop is tested as before, so the same drops are swept in the same order.)
+    const double r_max = mesh.radius_bound() + 1e-6;
+    if (std::isfinite(lo.x + lo.y + hi.x + hi.y)) {
+      Outline outline{{lo - r_max, glm::dvec2(hi.x + r_max, lo.y - r_max), hi + r_max,
+                       glm::dvec2(lo.x - r_max, hi.y + r_max)},
+                      4};
+      constexpr double kSlack = 1e-6;
+      outline.keep_where(d1, glm::dot(d1, pivot) - kSlack);
+      outline.keep_where(-d1, -glm::dot(d1, pivot) - length - kSlack);
+      outline.keep_where(n0, glm::dot(n0, pivot) - half - kSlack);
+      outline.keep_where(-n1, -glm::dot(n1, pivot) - half - r_max - kSlack);
+      mesh.drops_within(std::span(outline.corners.data(), outline.count), near_);
+    } else {  // (a turn of half a circle in one step: every drop, as the box rejects none)
+      near_.resize(drops.size());
+      for (std::size_t i = 0; i < drops.size(); ++i) near_[i] = static_cast<int>(i);
+    }
+    for (const int i : near_) {
       const MeshModel::Drop& d = drops[i];
       if (!d.alive || d.pos.x < lo.x - d.radius || d.pos.y < lo.y - d.radius ||
           d.pos.x > hi.x + d.radius || d.pos.y > hi.y + d.radius ||
@@ -85,7 +131,7 @@ void BladeSweep::sweep(const WaterInputs& in, MeshModel& mesh, ParticleModel& mo
       // Particles are equal: the drop's water joins what the blade already carries, and whole
       // particles' worth of it come off as particles here (a tiny trail drop alone makes none).
       const double mass = d.mass;
-      mesh.remove(static_cast<int>(i));
+      mesh.remove(i);
       if (particles.size() >= w.max_particles) {
         wiped_off_ += mass;
         continue;

@@ -38,6 +38,7 @@ class BladeSweep {
     std::uint32_t index;
   };
   std::vector<Swept> swept_;
+  std::vector<int> near_;  // the drops in the cells a blade's step reaches (scratch)
   double wiped_off_ = 0.0;
 };
 

@@ -64,6 +64,41 @@ int MeshModel::drop_at(glm::dvec2 p) const {
   return c < 0 ? -1 : cell_drop_[c];
 }
 
+void MeshModel::drops_within(std::span<const glm::dvec2> outline, std::vector<int>& out) const {
+  out.clear();
+  if (outline.empty()) return;
+  const double cell = config_.water.cell_mm;
+  double y_lo = outline[0].y, y_hi = outline[0].y;
+  for (const glm::dvec2& p : outline) y_lo = std::min(y_lo, p.y), y_hi = std::max(y_hi, p.y);
+  const int v0 = std::max(0, static_cast<int>(std::floor(y_lo / cell)));
+  const int v1 = std::min(cells_v_ - 1, static_cast<int>(std::floor(y_hi / cell)));
+  const std::size_t n = outline.size();
+  for (int v = v0; v <= v1; ++v) {
+    // The polygon's extremes across the row's band: its corners within the band, and where its
+    // edges cross the band's lines (a centre on a cell's upper line lies in the next row).
+    const double a = v * cell, b = (v + 1) * cell;
+    double x_lo = HUGE_VAL, x_hi = -HUGE_VAL;
+    for (std::size_t k = 0; k < n; ++k) {
+      const glm::dvec2 p = outline[k], q = outline[(k + 1) % n];
+      if (p.y >= a && p.y <= b) x_lo = std::min(x_lo, p.x), x_hi = std::max(x_hi, p.x);
+      for (const double y : {a, b}) {
+        if ((p.y < y) != (q.y < y)) {
+          const double x = p.x + (q.x - p.x) * ((y - p.y) / (q.y - p.y));
+          x_lo = std::min(x_lo, x), x_hi = std::max(x_hi, x);
+        }
+      }
+    }
+    if (x_hi < x_lo) continue;
+    const int u0 = std::max(0, static_cast<int>(std::floor(x_lo / cell)));
+    const int u1 = std::min(cells_u_ - 1, static_cast<int>(std::floor(x_hi / cell)));
+    const std::int32_t* row = cell_drop_.data() + static_cast<std::size_t>(v) * cells_u_;
+    for (int u = u0; u <= u1; ++u) {
+      if (row[u] >= 0) out.push_back(row[u]);
+    }
+  }
+  std::sort(out.begin(), out.end());
+}
+
 double MeshModel::mass() const {
   double m = 0.0;
   for (const Drop& d : drops_) {
@@ -75,6 +110,7 @@ double MeshModel::mass() const {
 void MeshModel::set_mass(Drop& d, double mass) {
   d.mass = mass;
   d.radius = drop_radius_mm(mass);
+  radius_bound_ = std::max(radius_bound_, d.radius);
 }
 
 int MeshModel::new_drop(glm::dvec2 pos, double mass) {

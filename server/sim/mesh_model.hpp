@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -50,6 +51,13 @@ class MeshModel {
   bool holds_critical_drop_near(glm::dvec2 pos) const;
 
   const std::vector<Drop>& drops() const { return drops_; }  // alive ones have alive = true
+  // The alive drops in the cells of the grid that the convex polygon `outline` reaches (its corners
+  // in order, either way round), by index, ascending, into `out` (cleared first): every drop whose
+  // centre lies in the polygon, and some beside it. It reads those cells, row by row, not every
+  // drop: a blade's step reaches a few thousand cells of the glass's 280,000.
+  void drops_within(std::span<const glm::dvec2> outline, std::vector<int>& out) const;
+  // No alive drop's radius is larger (mm): the largest any drop has had.
+  double radius_bound() const { return radius_bound_; }
   std::uint32_t count() const { return count_; }
   double mass() const;
   double drained() const { return drained_; }        // ran off the glass's edge, mg
@@ -82,6 +90,7 @@ class MeshModel {
   double air_spread_ = 0.0;  // its sideways part at the glass side edges, m/s
   double drained_ = 0.0;
   double evaporated_ = 0.0;
+  double radius_bound_ = 0.0;
 };
 
 }  // namespace downpour::sim

@@ -2,7 +2,9 @@
 // switching, rain arrival and determinism.
 #include "server/sim/water.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
@@ -10,6 +12,7 @@
 #include "server/sim/blade_sweep.hpp"
 #include "server/sim/mesh_model.hpp"
 #include "server/sim/particle_model.hpp"
+#include "server/sim/random.hpp"
 #include "server/sim/scenario.hpp"
 #include "server/sim/simulation.hpp"
 #include "server/sim/wipers.hpp"
@@ -228,6 +231,86 @@ TEST(WaterTest, ABladeStacksWhatItSweepsInTheOrderItStood) {
   for (std::size_t i = 5; i + 1 < p.size(); ++i) {
     EXPECT_GT(ahead(i) - ahead(i - 1), 0.5) << "fifteen in their order, apart: " << i;
     EXPECT_LE(ahead(i), region - r + 1e-6) << "wholly inside the particles' region: " << i;
+  }
+}
+
+// The sweep finds the drops a blade may reach through the grid's cells (MeshModel::drops_within),
+// not by a pass over every drop: for convex polygons of every shape and place, the cells it reads
+// hold every drop whose centre lies inside, each once, by index, and not many more.
+TEST(WaterTest, TheCellsOfAPolygonHoldEveryDropInsideIt) {
+  const WindshieldConfig config;
+  MeshModel mesh(config, 5);
+  RandomStream random(5, 1);
+  for (int k = 0; k < 20000; ++k)
+    mesh.place({random.uniform(0.0, 1520.0), random.uniform(0.0, 760.0)}, 0.02, nullptr);
+  ASSERT_GT(mesh.count(), 10000u);
+  std::vector<int> found;
+  for (int trial = 0; trial < 200; ++trial) {
+    // A convex polygon: a regular one of 3-8 corners, stretched and turned, anywhere (also
+    // partly off the glass).
+    const int n = 3 + trial % 6;
+    const glm::dvec2 centre(random.uniform(-100.0, 1620.0), random.uniform(-100.0, 860.0));
+    const double a = random.uniform(2.0, 400.0), b = random.uniform(2.0, 60.0);
+    const double turn = random.uniform(0.0, 2.0 * M_PI);
+    const glm::dvec2 e(std::cos(turn), std::sin(turn)), f(-e.y, e.x);
+    std::vector<glm::dvec2> outline;
+    for (int k = 0; k < n; ++k) {
+      const double t = (trial % 2 ? 1.0 : -1.0) * 2.0 * M_PI * k / n;
+      outline.push_back(centre + a * std::cos(t) * e + b * std::sin(t) * f);
+    }
+    mesh.drops_within(outline, found);
+    ASSERT_TRUE(std::is_sorted(found.begin(), found.end())) << trial;
+    ASSERT_TRUE(std::adjacent_find(found.begin(), found.end()) == found.end()) << trial;
+    std::size_t inside = 0;
+    const std::vector<MeshModel::Drop>& drops = mesh.drops();
+    for (std::size_t i = 0; i < drops.size(); ++i) {
+      if (!drops[i].alive) continue;
+      bool in = true;  // on the inner side of every edge (the corners go round one way)
+      for (int k = 0; k < n; ++k) {
+        const glm::dvec2 p = outline[k], q = outline[(k + 1) % n], d = drops[i].pos - p;
+        const double cross = (q.x - p.x) * d.y - (q.y - p.y) * d.x;
+        in &= trial % 2 ? cross >= 0.0 : cross <= 0.0;
+      }
+      if (!in) continue;
+      ++inside;
+      ASSERT_TRUE(std::binary_search(found.begin(), found.end(), static_cast<int>(i)))
+          << "drop " << i << " inside polygon " << trial;
+    }
+    for (const int i : found) ASSERT_TRUE(drops[i].alive) << trial;
+    // Beside the inside ones, only those of the cells its outline crosses.
+    const double perimeter = 4.0 * (a + b);
+    EXPECT_LE(found.size(), inside + 2 * static_cast<std::size_t>(perimeter / 2.0) + 4) << trial;
+  }
+}
+
+// A blade that turns far in a step (a manual wiper can jump) sweeps the drops it passes: the cells
+// the sweep reads hold them for a turn of 3, 40 and 85 degrees. (Past a quarter turn the swept
+// test, along the blade after the step, no longer covers the sector it crossed.)
+TEST(WaterTest, ABladeSweepsTheDropsItPassesHoweverFarItTurns) {
+  for (const double turn_deg : {3.0, 40.0, 85.0}) {
+    const WindshieldConfig config;
+    MeshModel mesh(config, 7);
+    ParticleModel particles(config.water);
+    BladeSweep sweep(config.water, 7);
+    WaterInputs in = still_inputs();
+    const BladePose& before = in.blades_before[0];
+    in.blades_after[0].angle_rad = before.angle_rad + static_cast<float>(turn_deg * M_PI / 180.0);
+    const glm::dvec2 pivot(before.pivot_mm);
+    // Drops on rays inside the sector the blade crosses, clear of its ends, on the glass.
+    std::vector<glm::dvec2> placed;
+    for (int ray = 1; ray < 8; ++ray) {
+      const double angle = before.angle_rad + (turn_deg * M_PI / 180.0) * ray / 8.0;
+      for (double along = 60.0; along < before.length_mm - 20.0; along += 37.0) {
+        const glm::dvec2 p = pivot + along * blade_direction(angle);
+        if (config.glass.contains(p)) placed.push_back(p);
+      }
+    }
+    for (const glm::dvec2& p : placed) mesh.place(p, 0.05, nullptr);
+    ASSERT_GE(mesh.count(), 10u);
+    sweep.sweep(in, mesh, particles);
+    for (const glm::dvec2& p : placed)
+      EXPECT_LT(mesh.drop_at(p), 0)
+          << turn_deg << " degrees, a drop left at " << p.x << ", " << p.y;
   }
 }
 
