@@ -105,7 +105,7 @@ const std::uint16_t* RainLayer::occlude(const RainLayerInputs& in, float sx, flo
 
 RainLayer::Bounds RainLayer::draw_splashes(const sim::RainState& rain, const RainLayerInputs& in,
                                            const glm::mat4& view, float sx, float sy, float cx,
-                                           float cy) {
+                                           float cy, std::vector<Texel>& out) const {
   if (rain.splashes.empty()) return {};
   // The car's frame to the camera's, for the splashes on it (they move with the car).
   const glm::mat4 car_view(glm::dmat4(in.view) * in.vehicle_to_world);
@@ -124,8 +124,7 @@ RainLayer::Bounds RainLayer::draw_splashes(const sim::RainState& rain, const Rai
     const std::uint16_t depth_c = depth_cm(depth);
     for (int k = 0; k < 4; ++k) {
       if (occludable && !occluded_.empty() && depth_c > occluder_depth_[texel[k]]) continue;
-      add(texels_[texel[k]], static_cast<std::uint32_t>(alpha * w[k] * kAlphaUnits + 0.5f),
-          depth_c);
+      add(out[texel[k]], static_cast<std::uint32_t>(alpha * w[k] * kAlphaUnits + 0.5f), depth_c);
     }
     lo_x = std::min(lo_x, ix), hi_x = std::max(hi_x, ix + 2);
     lo_y = std::min(lo_y, iy), hi_y = std::max(hi_y, iy + 2);
