@@ -107,7 +107,7 @@ void BladeSweep::sweep(const WaterInputs& in, MeshModel& mesh, ParticleModel& mo
     // cut by each line in turn. (A hair wider all round: the cells it reaches are a superset,
     // and each drop is tested as before, so the same drops are swept in the same order.)
     const double r_max = mesh.radius_bound() + 1e-6;
-    if (std::isfinite(lo.x + lo.y + hi.x + hi.y)) {
+    if (std::isfinite(lo.x + lo.y + hi.x + hi.y + r_max)) {
       Outline outline{{lo - r_max, glm::dvec2(hi.x + r_max, lo.y - r_max), hi + r_max,
                        glm::dvec2(lo.x - r_max, hi.y + r_max)},
                       4};

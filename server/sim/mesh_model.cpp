@@ -67,11 +67,24 @@ int MeshModel::drop_at(glm::dvec2 p) const {
 void MeshModel::drops_within(std::span<const glm::dvec2> outline, std::vector<int>& out) const {
   out.clear();
   if (outline.empty()) return;
+  // A polygon with a corner at no finite place holds what it may: every drop.
+  for (const glm::dvec2& p : outline) {
+    if (std::isfinite(p.x) && std::isfinite(p.y)) continue;
+    for (std::size_t i = 0; i < drops_.size(); ++i) {
+      if (drops_[i].alive) out.push_back(static_cast<int>(i));
+    }
+    return;
+  }
   const double cell = config_.water.cell_mm;
+  // The cell at x along an axis of `cells`, as a double clamped to just past the grid before it
+  // becomes an int (a blade turning half a circle in a step reaches metres, past an int's range).
+  auto at = [cell](double x, int cells) {
+    return static_cast<int>(std::clamp(std::floor(x / cell), -1.0, static_cast<double>(cells)));
+  };
   double y_lo = outline[0].y, y_hi = outline[0].y;
   for (const glm::dvec2& p : outline) y_lo = std::min(y_lo, p.y), y_hi = std::max(y_hi, p.y);
-  const int v0 = std::max(0, static_cast<int>(std::floor(y_lo / cell)));
-  const int v1 = std::min(cells_v_ - 1, static_cast<int>(std::floor(y_hi / cell)));
+  const int v0 = std::max(0, at(y_lo, cells_v_));
+  const int v1 = std::min(cells_v_ - 1, at(y_hi, cells_v_));
   const std::size_t n = outline.size();
   for (int v = v0; v <= v1; ++v) {
     // The polygon's extremes across the row's band: its corners within the band, and where its
@@ -89,8 +102,8 @@ void MeshModel::drops_within(std::span<const glm::dvec2> outline, std::vector<in
       }
     }
     if (x_hi < x_lo) continue;
-    const int u0 = std::max(0, static_cast<int>(std::floor(x_lo / cell)));
-    const int u1 = std::min(cells_u_ - 1, static_cast<int>(std::floor(x_hi / cell)));
+    const int u0 = std::max(0, at(x_lo, cells_u_));
+    const int u1 = std::min(cells_u_ - 1, at(x_hi, cells_u_));
     const std::int32_t* row = cell_drop_.data() + static_cast<std::size_t>(v) * cells_u_;
     for (int u = u0; u <= u1; ++u) {
       if (row[u] >= 0) out.push_back(row[u]);

@@ -54,7 +54,8 @@ class MeshModel {
   // The alive drops in the cells of the grid that the convex polygon `outline` reaches (its corners
   // in order, either way round), by index, ascending, into `out` (cleared first): every drop whose
   // centre lies in the polygon, and some beside it. It reads those cells, row by row, not every
-  // drop: a blade's step reaches a few thousand cells of the glass's 280,000.
+  // drop: a blade's step reaches a few thousand cells of the glass's 280,000. (Every drop for a
+  // polygon with a corner at no finite place.)
   void drops_within(std::span<const glm::dvec2> outline, std::vector<int>& out) const;
   // No alive drop's radius is larger (mm): the largest any drop has had.
   double radius_bound() const { return radius_bound_; }

@@ -314,6 +314,68 @@ TEST(WaterTest, ABladeSweepsTheDropsItPassesHoweverFarItTurns) {
   }
 }
 
+// The sweep takes exactly the drops that a test of every drop takes (the sweep's own test, over
+// the sector's box and the blade's reach), whichever way and however far the blade turns: on
+// fields of drops of every size, for turns of either sign up to just under half a circle (where
+// the box reaches metres past the glass).
+TEST(WaterTest, ABladeSweepsExactlyTheDropsATestOfEveryDropWouldTake) {
+  const WindshieldConfig config;
+  RandomStream random(11, 2);
+  const float turns[] = {0.05f, -0.05f, 0.6f, -0.6f, 1.5f, -1.5f, 3.1415925f, -3.1415925f};
+  for (int trial = 0; trial < 48; ++trial) {
+    MeshModel mesh(config, 100 + trial);
+    ParticleModel particles(config.water);
+    BladeSweep sweep(config.water, 100 + trial);
+    for (int k = 0; k < 4000; ++k) {
+      const glm::dvec2 p(random.uniform(0.0, 1520.0), random.uniform(0.0, 760.0));
+      if (config.glass.contains(p)) mesh.place(p, random.uniform(0.001, 20.0), nullptr);
+    }
+    WaterInputs in = still_inputs();
+    const BladePose& before = in.blades_before[0];
+    BladePose& after = in.blades_after[0];
+    after.angle_rad = before.angle_rad + turns[trial % 8];
+    // The test of every drop: the sector's box, grown by the drop's radius, and the blade's reach.
+    const double turn = after.angle_rad - before.angle_rad;
+    const double side = turn > 0.0 ? 1.0 : -1.0;
+    const glm::dvec2 pivot(after.pivot_mm);
+    const glm::dvec2 d0 = blade_direction(before.angle_rad), d1 = blade_direction(after.angle_rad);
+    const glm::dvec2 n0 = side * left_normal(d0), n1 = side * left_normal(d1);
+    const double half = 0.5 * after.width_mm, length = after.length_mm;
+    const glm::dvec2 mid = blade_direction(0.5f * (before.angle_rad + after.angle_rad));
+    const glm::dvec2 bulge = pivot + mid * (length / std::cos(0.5 * turn));
+    const glm::dvec2 tip0 = pivot + d0 * length, tip1 = pivot + d1 * length;
+    const glm::dvec2 lo = glm::min(glm::min(pivot, bulge), glm::min(tip0, tip1)) - half;
+    const glm::dvec2 hi = glm::max(glm::max(pivot, bulge), glm::max(tip0, tip1)) + half;
+    auto taken = [&](const MeshModel::Drop& d) {
+      if (d.pos.x < lo.x - d.radius || d.pos.y < lo.y - d.radius || d.pos.x > hi.x + d.radius ||
+          d.pos.y > hi.y + d.radius)
+        return false;
+      const glm::dvec2 rel = d.pos - pivot;
+      const double along = glm::dot(d1, rel);
+      if (along < 0.0 || along > length) return false;
+      return glm::dot(n0, rel) >= -half && glm::dot(n1, rel) < half + d.radius;
+    };
+    std::vector<bool> expected(mesh.drops().size(), false);
+    std::size_t expected_count = 0;
+    for (std::size_t i = 0; i < mesh.drops().size(); ++i) {
+      expected[i] = mesh.drops()[i].alive && taken(mesh.drops()[i]);
+      expected_count += expected[i];
+    }
+    const std::vector<MeshModel::Drop> drops_before = mesh.drops();
+    sweep.sweep(in, mesh, particles);
+    for (std::size_t i = 0; i < drops_before.size(); ++i) {
+      if (!drops_before[i].alive) continue;
+      ASSERT_EQ(!mesh.drops()[i].alive, expected[i])
+          << "trial " << trial << " (a turn of " << turns[trial % 8] << " rad), drop " << i
+          << " at " << drops_before[i].pos.x << ", " << drops_before[i].pos.y << " radius "
+          << drops_before[i].radius;
+    }
+    if (turns[trial % 8] > 0.5f) {  // (turning down from its park, a blade leaves the glass)
+      EXPECT_GT(expected_count, 0u) << trial;
+    }
+  }
+}
+
 TEST(WaterTest, AParticlePressedByManyPartsWithoutOvershooting) {
   // One particle with six others each overlapping it by half a diameter, fanned out over its
   // upper right: it gives way by about an overlap, not by the six overlaps summed.
