@@ -107,20 +107,19 @@ void BladeSweep::sweep(const WaterInputs& in, MeshModel& mesh, ParticleModel& mo
     // cut by each line in turn. (A hair wider all round: the cells it reaches are a superset,
     // and each drop is tested as before, so the same drops are swept in the same order.)
     const double r_max = mesh.radius_bound() + 1e-6;
+    Outline outline{{lo - r_max, glm::dvec2(hi.x + r_max, lo.y - r_max), hi + r_max,
+                     glm::dvec2(lo.x - r_max, hi.y + r_max)},
+                    4};
+    // (A box at no finite place, from a turn of half a circle in a step, is left whole: the grid
+    // then gives every drop, as the box rejects none.)
     if (std::isfinite(lo.x + lo.y + hi.x + hi.y + r_max)) {
-      Outline outline{{lo - r_max, glm::dvec2(hi.x + r_max, lo.y - r_max), hi + r_max,
-                       glm::dvec2(lo.x - r_max, hi.y + r_max)},
-                      4};
       constexpr double kSlack = 1e-6;
       outline.keep_where(d1, glm::dot(d1, pivot) - kSlack);
       outline.keep_where(-d1, -glm::dot(d1, pivot) - length - kSlack);
       outline.keep_where(n0, glm::dot(n0, pivot) - half - kSlack);
       outline.keep_where(-n1, -glm::dot(n1, pivot) - half - r_max - kSlack);
-      mesh.drops_within(std::span(outline.corners.data(), outline.count), near_);
-    } else {  // (a turn of half a circle in one step: every drop, as the box rejects none)
-      near_.resize(drops.size());
-      for (std::size_t i = 0; i < drops.size(); ++i) near_[i] = static_cast<int>(i);
     }
+    mesh.drops_within(std::span(outline.corners.data(), outline.count), near_);
     for (const int i : near_) {
       const MeshModel::Drop& d = drops[i];
       if (!d.alive || d.pos.x < lo.x - d.radius || d.pos.y < lo.y - d.radius ||

@@ -281,6 +281,11 @@ TEST(WaterTest, TheCellsOfAPolygonHoldEveryDropInsideIt) {
     const double perimeter = 4.0 * (a + b);
     EXPECT_LE(found.size(), inside + 2 * static_cast<std::size_t>(perimeter / 2.0) + 4) << trial;
   }
+  // A polygon with a corner at no finite place holds every drop.
+  const std::vector<glm::dvec2> endless = {
+      {100.0, 100.0}, {HUGE_VAL, 100.0}, {100.0, std::nan("")}};
+  mesh.drops_within(endless, found);
+  EXPECT_EQ(found.size(), mesh.count());
 }
 
 // A blade that turns far in a step (a manual wiper can jump) sweeps the drops it passes: the cells
