@@ -2,7 +2,7 @@
 // An environment face from a client's picture (client_background_pass.hpp): each of the face's
 // directions where the picture shows it, its edges extended beyond; depth 0 where it is the sky.
 #include "common.glsl"
-in vec2 v_uv;
+in vec3 v_ray;  // fullscreen_ray.vert
 out vec4 out_colour;
 uniform vec3 u_forward;  // the picture's camera (world, unit axes)
 uniform vec3 u_right;
@@ -22,8 +22,7 @@ bool in_cabin(vec2 uv_up, float z) {
 }
 
 void main() {
-  vec4 far_point = frame.inv_view_proj * vec4(v_uv * 2.0 - 1.0, 1e-6, 1.0);
-  vec3 dir = normalize(far_point.xyz / far_point.w - frame.camera_pos.xyz);
+  vec3 dir = normalize(v_ray);
   // Behind the camera the ray runs to the picture's edge the way it leans.
   float ahead = max(dot(dir, u_forward), 1e-3);
   vec2 p = vec2(dot(dir, u_right), dot(dir, u_up)) / (ahead * u_tan);

@@ -4,6 +4,7 @@
 // (common.glsl's fog), by the picture's depth or the ground under the car; its sky stays as it is.
 #include "common.glsl"
 in vec2 v_uv;
+in vec3 v_ray;  // fullscreen_ray.vert
 out vec4 out_colour;
 uniform vec3 u_forward;   // the picture's camera's axis (world, unit)
 uniform vec4 u_ground;    // xyz the ground's unit normal (world), w the camera's height over it
@@ -12,8 +13,7 @@ uniform float u_near;
 
 void main() {
   vec3 seen = textureLod(client_image_tex, v_uv, 0.0).rgb;
-  vec4 far_point = frame.inv_view_proj * vec4(v_uv * 2.0 - 1.0, 1e-6, 1.0);
-  vec3 dir = normalize(far_point.xyz / far_point.w - frame.camera_pos.xyz);
+  vec3 dir = normalize(v_ray);
   float along = 0.0;  // the distance along the ray; 0: the sky
   if (u_has_depth != 0) {
     float d = textureLod(client_depth_tex, v_uv, 0.0).r;

@@ -1,10 +1,9 @@
 #version 450
 #include "common.glsl"
-in vec2 v_uv;
+in vec3 v_ray;  // fullscreen_ray.vert
 out vec4 out_colour;
 void main() {
-  vec4 far_point = frame.inv_view_proj * vec4(v_uv * 2.0 - 1.0, 1e-6, 1.0);
-  vec3 dir = normalize(far_point.xyz / far_point.w - frame.camera_pos.xyz);
+  vec3 dir = normalize(v_ray);
   vec3 sky = sky_gradient(dir);
   // A cloud deck at about 1.5 km, drifting with the wind; it thickens and greys with overcast.
   if (dir.z > 0.0) {

@@ -18,7 +18,7 @@ void ClientBackgroundPass::execute(const FrameContext&, const FrameResources& r)
 
 ClientHazePass::ClientHazePass(SharedResources& shared)
     : shared_(shared),
-      program_("fullscreen.vert", "client_haze.frag"),
+      program_("fullscreen_ray.vert", "client_haze.frag"),
       u_forward_(program_.uniform("u_forward")),
       u_ground_(program_.uniform("u_ground")),
       u_has_depth_(program_.uniform("u_has_depth")),
@@ -44,7 +44,7 @@ void ClientHazePass::execute(const FrameContext& frame, const FrameResources& r)
 
 ClientEnvironmentPass::ClientEnvironmentPass(SharedResources& shared)
     : shared_(shared),
-      program_("fullscreen.vert", "client_environment.frag"),
+      program_("fullscreen_ray.vert", "client_environment.frag"),
       u_forward_(program_.uniform("u_forward")),
       u_right_(program_.uniform("u_right")),
       u_up_(program_.uniform("u_up")),

@@ -4,7 +4,7 @@ namespace downpour::render {
 
 EnvironmentBackgroundPass::EnvironmentBackgroundPass(SharedResources& shared)
     : shared_(shared),
-      program_("fullscreen.vert", "environment_background.frag"),
+      program_("fullscreen_ray.vert", "environment_background.frag"),
       u_env_from_world_(program_.uniform("u_env_from_world")) {}
 
 void EnvironmentBackgroundPass::execute(const FrameContext&, const FrameResources& resources) {

@@ -3,7 +3,7 @@
 namespace downpour::render {
 
 SkyPass::SkyPass(SharedResources& shared)
-    : shared_(shared), program_("fullscreen.vert", "sky.frag") {}
+    : shared_(shared), program_("fullscreen_ray.vert", "sky.frag") {}
 
 void SkyPass::execute(const FrameContext&, const FrameResources&) {
   program_.use();
