@@ -1,4 +1,5 @@
-// A static mesh in world space (mesh.vert); with MESH_CURVATURE, its vertices' principal
+// A static mesh in world space (mesh.vert); with MESH_IN_CAR, in the car's frame, placed on the
+// screen by u_clip_from_car (cabin.vert); with MESH_CURVATURE, its vertices' principal
 // curvatures and directions passed on for the relief shadows (road.vert); with MESH_WHEELS, a
 // vehicle or cabin model whose wheels turn (model.vert).
 #include "common.glsl"
@@ -6,6 +7,9 @@ layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
 uniform mat4 u_model;
+#ifdef MESH_IN_CAR
+uniform mat4 u_clip_from_car;
+#endif
 out vec3 v_world;
 out vec3 v_normal;
 out vec2 v_uv;
@@ -68,10 +72,15 @@ void main() {
 #else
   v_texture = vec3(0.0, 0.0, -1.0);
 #endif
+#ifdef MESH_IN_CAR
+  gl_Position = u_clip_from_car * world;
+  gl_ClipDistance[0] = 1.0;  // (the cabin is never in the road's mirror)
+#else
   gl_Position = frame.view_proj * world;
   // The road reflection keeps what is above the road; other frames' plane keeps everything (a
   // distance written is a distance used on llvmpipe, enabled or not).
   gl_ClipDistance[0] = dot(frame.clip_plane.xyz, world.xyz) + frame.clip_plane.w;
+#endif
 #ifdef MESH_CURVATURE
   gl_ClipDistance[1] = u_near_split.y * (u_near_split.x - distance(world.xyz, frame.camera_pos.xyz));
   gl_ClipDistance[2] = dot(u_depth_clip.xyz, world.xyz) + u_depth_clip.w;

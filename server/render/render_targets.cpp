@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "server/render/gl/render_state.hpp"
+
 namespace downpour::render {
 
 namespace {
@@ -36,6 +38,14 @@ Framebuffer framebuffer_with(GLuint colour, GLuint depth) {
   return fbo;
 }
 
+void clear_view(GLuint fbo) {
+  apply(RenderState{DepthTest::kOff, true, Blend::kOff});
+  const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+  const float zero_depth = 0.0f;
+  glClearNamedFramebufferfv(fbo, GL_COLOR, 0, black);
+  glClearNamedFramebufferfv(fbo, GL_DEPTH, 0, &zero_depth);
+}
+
 namespace {
 
 // Readback buffers of `bytes` each.
@@ -52,18 +62,22 @@ std::array<Buffer, kReadbackSlots> readback_buffers(std::size_t bytes) {
 
 }  // namespace
 
-GroundTruthTarget::GroundTruthTarget(int w, int h, GLuint view_depth) {
+GroundTruthTarget::GroundTruthTarget(int w, int h,
+                                     const std::array<Texture, kReadbackSlots>& view_depth) {
   const std::size_t pixels = static_cast<std::size_t>(w) * h;
   clean = make_texture_2d(GL_RGBA8, w, h);
-  clean_fbo = framebuffer_with(clean.id(), view_depth);
+  for (int i = 0; i < kReadbackSlots; ++i)
+    clean_fbo[i] = framebuffer_with(clean.id(), view_depth[i].id());
   clean_pbo = readback_buffers(pixels * 4);
   depth_pbo = readback_buffers(pixels * sizeof(float));
 }
 
 ViewTarget::ViewTarget(int w, int h) : width(w), height(h) {
-  colour = make_texture_2d(GL_RGBA8, w, h);
-  depth = make_texture_2d(GL_DEPTH_COMPONENT32F, w, h);
-  fbo = framebuffer_with(colour.id(), depth.id());
+  for (int i = 0; i < kReadbackSlots; ++i) {
+    colour[i] = make_texture_2d(GL_RGBA8, w, h);
+    depth[i] = make_texture_2d(GL_DEPTH_COMPONENT32F, w, h);
+    fbo[i] = framebuffer_with(colour[i].id(), depth[i].id());
+  }
   pbo = readback_buffers(static_cast<std::size_t>(w) * h * 4);
 }
 

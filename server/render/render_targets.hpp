@@ -20,26 +20,33 @@ inline constexpr int kReadbackSlots = 2;
 // A framebuffer with these attachments (0: none); throws if GL finds it incomplete.
 Framebuffer framebuffer_with(GLuint colour, GLuint depth);
 
+// A view's start: colour black, depth 0 (reversed-Z's infinity), in framebuffer `fbo` (its depth
+// mask turned on, which clears obey).
+void clear_view(GLuint fbo);
+
 // A view's ground truth (sim::Outputs) on its way back: the clean frame's colour (the view's
-// colour before the first pass that adds water; its framebuffer has the view's depth, so that the
-// blades drawn over it hide behind the cabin as they do in the frame), and readback buffers for it
-// and for the view's depth.
+// colour before the first pass that adds water; its framebuffer has the slot's view depth, so that
+// the blades drawn over it hide behind the cabin as they do in the frame), and readback buffers for
+// it and for the view's depth.
 struct GroundTruthTarget {
   Texture clean;
-  Framebuffer clean_fbo;
+  std::array<Framebuffer, kReadbackSlots> clean_fbo;
   std::array<Buffer, kReadbackSlots> clean_pbo;
   std::array<Buffer, kReadbackSlots> depth_pbo;
 
-  GroundTruthTarget(int w, int h, GLuint view_depth);
+  GroundTruthTarget(int w, int h, const std::array<Texture, kReadbackSlots>& view_depth);
 };
 
-// A view's colour and depth, and its readback buffers.
+// A view's colour and depth, and its readback buffers: a set per readback slot, the slots used in
+// turn. A frame draws into the slot whose last frame has been read back, so a copy into its target
+// at the frame's start (CockpitPass's cabin) finds nothing still drawing into it: on llvmpipe it
+// would wait for the frame before, which pipelining still has in flight.
 struct ViewTarget {
   int width = 0;
   int height = 0;
-  Texture colour;
-  Texture depth;
-  Framebuffer fbo;
+  std::array<Texture, kReadbackSlots> colour;
+  std::array<Texture, kReadbackSlots> depth;
+  std::array<Framebuffer, kReadbackSlots> fbo;
   std::array<Buffer, kReadbackSlots> pbo;
   std::array<GLsync, kReadbackSlots> fence{};  // a readback in flight per slot
   int next_slot = 0;

@@ -22,6 +22,7 @@
 #include "server/render/frame_context.hpp"
 #include "server/render/frame_lamps.hpp"
 #include "server/render/pass.hpp"
+#include "server/render/passes/cockpit_pass.hpp"
 #include "server/render/passes/glass_composite_pass.hpp"
 #include "server/render/passes/lamp_map_pass.hpp"
 #include "server/render/passes/rain_pass.hpp"
@@ -354,7 +355,7 @@ struct Renderer::Impl {
   // The ground truth's clean frame: the view as it stands (before its water).
   void take_clean(ViewFrame::State& v) {
     timed("clean_copy", [&] {
-      glCopyImageSubData(v.target->colour.id(), GL_TEXTURE_2D, 0, 0, 0, 0,
+      glCopyImageSubData(v.target->colour[v.slot].id(), GL_TEXTURE_2D, 0, 0, 0, 0,
                          v.target->truth->clean.id(), GL_TEXTURE_2D, 0, 0, 0, 0, v.spec.width,
                          v.spec.height, 1);
     });
@@ -394,10 +395,10 @@ struct Renderer::Impl {
     if (v.wants_clean && pass == static_cast<Pass*>(passes.glass_composite) &&
         pass->wanted(frame)) {
       timed("clean_blades", [&] {
-        glBindFramebuffer(GL_FRAMEBUFFER, v.target->truth->clean_fbo.id());
+        glBindFramebuffer(GL_FRAMEBUFFER, v.target->truth->clean_fbo[v.slot].id());
         apply(pass->decl().state);
         passes.glass_composite->draw_blades(frame);
-        glBindFramebuffer(GL_FRAMEBUFFER, v.target->fbo.id());
+        glBindFramebuffer(GL_FRAMEBUFFER, v.target->fbo[v.slot].id());
       });
     }
   }
@@ -441,13 +442,18 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   impl->lamps = std::make_unique<FrameLamps>();
   impl->environment_programs = std::make_unique<EnvironmentPrograms>();
   impl->passes = make_view_passes(*impl->shared, *impl->block, *impl->lamps, smoothing,
-                                  options.road_at_half.value_or(cpu_rasterizer));
+                                  options.road_at_half.value_or(cpu_rasterizer),
+                                  options.keep_cabin.value_or(cpu_rasterizer));
   if (glGetError() != GL_NO_ERROR) throw std::runtime_error("GL error while creating the renderer");
   return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
 }
 
 const std::string& Renderer::gl_renderer() const { return impl_->context->renderer(); }
 const std::string& Renderer::platform() const { return impl_->context->platform(); }
+Renderer::CabinCounts Renderer::cabin_counts() const {
+  const CockpitPass::Counts& c = impl_->passes.cockpit->counts();
+  return {c.restored, c.drawn, c.kept};
+}
 void Renderer::set_profiling(bool on) { impl_->profiling = on; }
 void Renderer::set_spray_smoothing(SpraySmoothing smoothing) {
   impl_->passes.spray_smooth->set_smoothing(smoothing);
@@ -569,8 +575,7 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
   // Ground truth: the clean frame (for itself or the water mask) and the depth.
   v.wants_clean = spec.outputs.needs_clean();
   if (spec.outputs.any() && !target->truth) {
-    target->truth =
-        std::make_unique<GroundTruthTarget>(spec.width, spec.height, target->depth.id());
+    target->truth = std::make_unique<GroundTruthTarget>(spec.width, spec.height, target->depth);
   }
   v.frame.emplace(FrameContext{
       scene, spec, camera, atmosphere_from(scene.weather),
@@ -583,20 +588,22 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
       detail_distance_scale(2.0 * camera.tan_half_fov_y / std::max(spec.height, 1));
   if (new_target) m.prepare(frame);
   FrameResources& resources = v.resources;
-  resources.view_fbo = target->fbo.id();
-  resources.view_colour = {target->colour.id(), spec.width, spec.height};
-  resources.view_depth = {target->depth.id(), spec.width, spec.height};
-  glBindFramebuffer(GL_FRAMEBUFFER, target->fbo.id());
+  resources.view_fbo = target->fbo[slot].id();
+  resources.view_colour = {target->colour[slot].id(), spec.width, spec.height};
+  resources.view_depth = {target->depth[slot].id(), spec.width, spec.height};
+  const bool client = spec.background == sim::Background::kClient;
+  v.fixed = m.fixed_environment && spec.view == sim::View::kCockpit && !client;
+  v.passes = v.fixed ? &m.passes.fixed_environment_cockpit : &m.view_list(spec);
+  // A view that starts with the cabin may start from its kept picture, in place of the clear
+  // (before the target is bound: a target bound counts as one being drawn into).
+  const bool restored = !v.passes->empty() && v.passes->front() == m.passes.cockpit &&
+                        m.passes.cockpit->restore(frame, resources);
+  glBindFramebuffer(GL_FRAMEBUFFER, resources.view_fbo);
   glViewport(0, 0, spec.width, spec.height);
-  apply(RenderState{DepthTest::kOff, true, Blend::kOff});  // clears obey the depth mask
-  const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
-  const float zero_depth = 0.0f;
-  glClearNamedFramebufferfv(target->fbo.id(), GL_COLOR, 0, black);
-  glClearNamedFramebufferfv(target->fbo.id(), GL_DEPTH, 0, &zero_depth);
+  if (!restored) clear_view(resources.view_fbo);
   ++m.frame;
   m.transients.evict();
   m.written.fill(false);
-  const bool client = spec.background == sim::Background::kClient;
   const std::vector<Pass*>& frame_passes = m.frame_passes(spec);
   v.reflection = lists(frame_passes, m.passes.reflection) && m.passes.reflection->wanted(frame);
   // Profiling: the clears and the frame's uploads finish here, not in the first step's time.
@@ -606,8 +613,6 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
   for (Pass* pass : frame_passes)
     m.timed(pass->decl().name, [&] { m.run_pass(*pass, frame, s, resources); });
   if (lists(frame_passes, m.passes.lamp_map)) m.lamp_map_of = v.begun;
-  v.fixed = m.fixed_environment && spec.view == sim::View::kCockpit && !client;
-  v.passes = v.fixed ? &m.passes.fixed_environment_cockpit : &m.view_list(spec);
   // The passes that need only the frame's inputs: those before the first that reads the step.
   m.passes.rain->take_drawn();
   while (v.next_pass < v.passes->size() && !(*v.passes)[v.next_pass]->decl().reads_step)
@@ -635,7 +640,7 @@ PendingReadback Renderer::end(ViewFrame& view) {
   ViewTarget& target = *v.target;
   m.written = v.written;
   m.timings = std::move(v.timings);
-  glBindFramebuffer(GL_FRAMEBUFFER, target.fbo.id());
+  glBindFramebuffer(GL_FRAMEBUFFER, target.fbo[v.slot].id());
   glViewport(0, 0, spec.width, spec.height);
   // Passes left to draw (the glass's) after another view began or ended since this one began:
   // this one's lamps, blocks and sky again; its lamp map only if a face of the environment is
@@ -658,8 +663,8 @@ PendingReadback Renderer::end(ViewFrame& view) {
                           spec.width, spec.height,  spec.outputs, frame.camera.near_m};
   m.timed("readback_start", [&] {
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glNamedFramebufferReadBuffer(target.fbo.id(), GL_COLOR_ATTACHMENT0);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, target.fbo.id());
+    glNamedFramebufferReadBuffer(target.fbo[slot].id(), GL_COLOR_ATTACHMENT0);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, target.fbo[slot].id());
     glBindBuffer(GL_PIXEL_PACK_BUFFER, target.pbo[slot].id());
     glReadPixels(0, 0, spec.width, spec.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
     if (spec.outputs.depth) {
@@ -667,8 +672,8 @@ PendingReadback Renderer::end(ViewFrame& view) {
       glReadPixels(0, 0, spec.width, spec.height, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
     }
     if (v.wants_clean) {
-      glNamedFramebufferReadBuffer(target.truth->clean_fbo.id(), GL_COLOR_ATTACHMENT0);
-      glBindFramebuffer(GL_READ_FRAMEBUFFER, target.truth->clean_fbo.id());
+      glNamedFramebufferReadBuffer(target.truth->clean_fbo[slot].id(), GL_COLOR_ATTACHMENT0);
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, target.truth->clean_fbo[slot].id());
       glBindBuffer(GL_PIXEL_PACK_BUFFER, target.truth->clean_pbo[slot].id());
       glReadPixels(0, 0, spec.width, spec.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
     }

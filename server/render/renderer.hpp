@@ -27,6 +27,9 @@ struct RendererOptions {
   // The chase view's road drawn at half size and brought in (view_passes.hpp): by default where
   // the renderer is a CPU rasterizer (llvmpipe), which pays for every pixel it shades.
   std::optional<bool> road_at_half = std::nullopt;
+  // The cabin's pictures kept and copied back into the views that draw the same (CockpitPass): by
+  // default likewise.
+  std::optional<bool> keep_cabin = std::nullopt;
 };
 
 // The passes that draw a view's road (PassTiming::name): the road whole, or ROAD's near part into
@@ -121,6 +124,12 @@ class Renderer {
   const std::vector<PassTiming>& last_pass_timings() const;
   // Rain streaks drawn by the last render() (0 if it drew no rain).
   std::uint32_t last_rain_streaks() const;
+  // Frames whose cabin was copied from a kept picture, frames that drew it, and pictures kept
+  // (RendererOptions::keep_cabin), since the renderer was made.
+  struct CabinCounts {
+    std::uint64_t restored = 0, drawn = 0, kept = 0;
+  };
+  CabinCounts cabin_counts() const;
 
   std::unique_ptr<RenderSession> open_session();
 

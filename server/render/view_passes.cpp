@@ -25,14 +25,16 @@
 namespace downpour::render {
 
 ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
-                            const FrameLamps& lamps, SpraySmoothing smoothing, bool road_at_half) {
+                            const FrameLamps& lamps, SpraySmoothing smoothing, bool road_at_half,
+                            bool keep_cabin) {
   ViewPasses p;
   auto own = [&p](auto pass) {
     auto* raw = pass.get();
     p.owned.push_back(std::move(pass));
     return raw;
   };
-  Pass* cockpit = own(std::make_unique<CockpitPass>(shared));
+  p.cockpit = own(std::make_unique<CockpitPass>(shared, keep_cabin));
+  Pass* cockpit = p.cockpit;
   Pass* vehicles = own(std::make_unique<VehiclePass>(shared));
   Pass* street_lights = own(std::make_unique<StreetLightPass>(shared));
   p.road = own(std::make_unique<RoadPass>(shared));

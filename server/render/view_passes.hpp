@@ -15,6 +15,7 @@
 
 namespace downpour::render {
 
+class CockpitPass;
 class GlassCompositePass;
 class LampMapPass;
 class RainPass;
@@ -42,6 +43,7 @@ struct ViewPasses {
   // (ground truth, sim::Outputs) is its colour before the first of them.
   std::vector<const Pass*> water;
   // Those the renderer asks or tells something of.
+  CockpitPass* cockpit = nullptr;
   GlassCompositePass* glass_composite = nullptr;
   LampMapPass* lamp_map = nullptr;
   RoadReflectionPass* reflection = nullptr;
@@ -60,7 +62,9 @@ struct ViewPasses {
 // contract.
 // road_at_half: the chase view (ROAD) draws its road into the road's layer at half its size and
 // brings that in (RoadPass, RoadCompositePass), where shading costs for every pixel (llvmpipe).
+// keep_cabin: the cabin's pictures kept and restored (CockpitPass), likewise.
 ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
-                            const FrameLamps& lamps, SpraySmoothing smoothing, bool road_at_half);
+                            const FrameLamps& lamps, SpraySmoothing smoothing, bool road_at_half,
+                            bool keep_cabin);
 
 }  // namespace downpour::render

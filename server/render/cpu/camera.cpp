@@ -67,6 +67,7 @@ Camera make_camera(const sim::ViewSpec& spec, const sim::VehicleState& vehicle,
   // A camera in the cabin may sit a few centimetres from the raked glass.
   if (spec.view == sim::View::kCockpit || spec.view == sim::View::kRain) c.near_m = 0.01f;
   c.view = glm::mat4(glm::inverse(cam_to_world));
+  c.view_vehicle = glm::inverse(cam_in_vehicle * gl_axes);
   // Reversed-Z with an infinite far plane (clip control zero-to-one, depth test GREATER, clear 0):
   // float depth keeps its precision from the dashboard at 0.3 m to hills kilometres away.
   const float f = 1.0f / std::tan(glm::radians(c.fov_y_deg) * 0.5f);

@@ -19,6 +19,7 @@ struct Camera {
   // The rig in the vehicle frame: position (m) and axes (columns: forward, left, up).
   glm::dvec3 position_vehicle{0.0};
   glm::dmat3 axes_vehicle{1.0};
+  glm::dmat4 view_vehicle{1.0};  // the view matrix from the vehicle's frame (view's, less the pose)
   double tan_half_fov_x = 0.0;
   double tan_half_fov_y = 0.0;
   // The lens: focus distance (m) and aperture diameter (mm); ViewSpec's or the view's default.

@@ -1,5 +1,12 @@
 #pragma once
 
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "server/render/gl/gl_objects.hpp"
 #include "server/render/model_meshes.hpp"
 #include "server/render/pass.hpp"
 
@@ -8,22 +15,70 @@ namespace downpour::render {
 // The cabin around the driver's eye: dashboard edge, A-pillars, roof liner and mirror, dark
 // silhouettes framing the view through the windshield, built around the glass of the scene; or
 // the cabin model the session names.
+//
+// It is drawn in the car's frame (cabin.vert) and lit by the atmosphere's light turned into that
+// frame, so that for a camera fixed in the car its picture changes only with the light. Where the
+// renderer keeps its picture (llvmpipe, which pays as much for a cabin pixel as for any other: 1.5
+// ms of a 640x360 frame, 5 at 1280x720), the light is rounded (a sun direction to 1/64, radiances
+// to 1/128 of themselves), the cabin's picture on a cleared view (colour and depth) is kept under
+// everything it was drawn with, and a view whose frame would draw the same gets it back by a copy
+// in place of its clear and the draw (restore()). Drawn or copied, the pixels are the same.
 class CockpitPass final : public Pass {
  public:
-  explicit CockpitPass(SharedResources& shared);
+  // keep_pictures: keep the cabin's pictures and restore them (llvmpipe's choice).
+  CockpitPass(SharedResources& shared, bool keep_pictures);
+  ~CockpitPass() override;
   const PassDecl& decl() const override { return decl_; }
   void execute(const FrameContext& frame, const FrameResources& resources) override;
+  // At a view's start, in place of its clear, with nothing drawn into its target yet in this frame
+  // and nothing drawing into it still from an earlier one: the kept picture of this frame's cabin
+  // copied into the view's colour and depth, if there is one ready. Then execute() draws nothing.
+  bool restore(const FrameContext& frame, const FrameResources& resources);
+
+  // How many frames restored the cabin, and drew it (and how many of those kept the picture).
+  struct Counts {
+    std::uint64_t restored = 0, drawn = 0, kept = 0;
+  };
+  const Counts& counts() const { return counts_; }
 
  private:
+  // What a picture of the cabin is drawn with: the mesh, the view's size, the camera in the car's
+  // frame and the light; equal keys, equal pictures.
+  struct Key {
+    const ModelMesh* mesh = nullptr;
+    std::uint64_t mesh_serial = 0;  // (a named model's address may be another's later)
+    int width = 0, height = 0;
+    std::array<float, 16 + 5 * 3> numbers{};  // clip from car, eye, sun, ambient, sun, horizon
+    bool operator==(const Key&) const = default;
+  };
+  struct Kept;
+  Key key_of(const FrameContext& frame, const ModelMesh& mesh, std::uint64_t serial) const;
+  const ModelMesh& mesh_of(const FrameContext& frame, std::uint64_t* serial);
+  void draw(const ModelMesh& mesh, const Key& key);
+
   const PassDecl decl_{"cockpit",
                        {},
                        {Resource::kViewColour, Resource::kViewDepth},
                        {DepthTest::kNearer, true, Blend::kOff}};
   ShaderProgram program_;
   ModelUniforms uniforms_;
+  Uniform u_clip_from_car_, u_eye_, u_sun_dir_, u_ambient_, u_sun_radiance_, u_sky_horizon_;
   sim::GlassConfig built_for_;
   ModelMesh interior_;  // the built-in cabin round the glass
-  ModelMeshes named_;   // the cabin models sessions name
+  std::uint64_t interior_serial_ = 1;
+  ModelMeshes named_;  // the cabin models sessions name
+  struct Named {
+    std::weak_ptr<const model::VehicleModel> model;
+    std::uint64_t serial = 0;
+  };
+  std::map<const model::VehicleModel*, Named> named_serials_;
+  std::uint64_t serials_ = 1;
+  bool keep_pictures_;
+  std::vector<std::unique_ptr<Kept>> kept_;  // the latest few, the most recently used first
+  GLuint restored_into_ = 0;                 // the view colour restore() filled, until execute()
+  bool last_kept_used_ = true;               // whether a frame has restored the last picture kept
+  std::uint64_t drawn_at_keep_ = 0;          // counts().drawn when it was kept
+  Counts counts_;
 };
 
 }  // namespace downpour::render
