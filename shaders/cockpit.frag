@@ -9,6 +9,7 @@ in vec2 v_uv;  // x material id (MATERIAL_*, interface.glsl)
 in vec3 v_texture;  // where it reads model_tex: uv, layer (-1: none)
 uniform float u_textured;  // 1 where the model has textures, else 0
 uniform vec3 u_eye;           // the camera, car's frame
+uniform vec3 u_up;            // the world's up, car's frame
 uniform vec3 u_sun_dir;       // towards the sun, car's frame
 uniform vec3 u_ambient;       // Atmosphere's
 uniform vec3 u_sun_radiance;
@@ -23,7 +24,7 @@ void main() {
   // A glTF cabin's base-colour texture times its colour (uniform control flow, as vehicle.frag).
   if (u_textured > 0.5)
     albedo *= mix(vec3(1.0), texture(model_tex, v_texture).rgb, step(-0.5, v_texture.z));
-  vec3 light = u_ambient * (0.35 + 0.4 * max(n.z, 0.0)) + u_sun_radiance * 0.15 * max(dot(n, u_sun_dir), 0.0);
+  vec3 light = u_ambient * (0.35 + 0.4 * max(dot(n, u_up), 0.0)) + u_sun_radiance * 0.15 * max(dot(n, u_sun_dir), 0.0);
   float sheen = schlick(dot(n, view), 0.03) * 0.3;
   out_colour = vec4(to_display(albedo * light + u_sky_horizon * sheen), 1.0);
 }

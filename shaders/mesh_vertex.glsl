@@ -59,7 +59,11 @@ void main() {
   v_world = world.xyz;
   v_normal = mat3(u_model) * normal;
   v_uv = a_uv;
+#ifdef MESH_IN_CAR
+  v_fog = vec4(0.0);  // (the cabin is not fogged)
+#else
   v_fog = fog_at(world.xyz);
+#endif
 #ifdef MESH_CURVATURE
   v_curvature = a_curvature;
   v_principal_dirs = a_principal_dirs;

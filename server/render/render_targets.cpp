@@ -63,17 +63,19 @@ std::array<Buffer, kReadbackSlots> readback_buffers(std::size_t bytes) {
 }  // namespace
 
 GroundTruthTarget::GroundTruthTarget(int w, int h,
-                                     const std::array<Texture, kReadbackSlots>& view_depth) {
+                                     const std::array<Texture, kReadbackSlots>& view_depth,
+                                     int pictures) {
   const std::size_t pixels = static_cast<std::size_t>(w) * h;
   clean = make_texture_2d(GL_RGBA8, w, h);
-  for (int i = 0; i < kReadbackSlots; ++i)
+  for (int i = 0; i < pictures; ++i)
     clean_fbo[i] = framebuffer_with(clean.id(), view_depth[i].id());
   clean_pbo = readback_buffers(pixels * 4);
   depth_pbo = readback_buffers(pixels * sizeof(float));
 }
 
-ViewTarget::ViewTarget(int w, int h) : width(w), height(h) {
-  for (int i = 0; i < kReadbackSlots; ++i) {
+ViewTarget::ViewTarget(int w, int h, int pictures_)
+    : width(w), height(h), pictures(std::clamp(pictures_, 1, kReadbackSlots)) {
+  for (int i = 0; i < pictures; ++i) {
     colour[i] = make_texture_2d(GL_RGBA8, w, h);
     depth[i] = make_texture_2d(GL_DEPTH_COMPONENT32F, w, h);
     fbo[i] = framebuffer_with(colour[i].id(), depth[i].id());

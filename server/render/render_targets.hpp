@@ -34,17 +34,21 @@ struct GroundTruthTarget {
   std::array<Buffer, kReadbackSlots> clean_pbo;
   std::array<Buffer, kReadbackSlots> depth_pbo;
 
-  GroundTruthTarget(int w, int h, const std::array<Texture, kReadbackSlots>& view_depth);
+  // view_depth: the view's depth textures, `pictures` of them (ViewTarget).
+  GroundTruthTarget(int w, int h, const std::array<Texture, kReadbackSlots>& view_depth,
+                    int pictures);
 };
 
-// A view's colour and depth, and its readback buffers: a set per readback slot, the slots used in
-// turn. A frame draws into the slot whose last frame has been read back, so a copy into its target
-// at the frame's start (CockpitPass's cabin) finds nothing still drawing into it: on llvmpipe it
-// would wait for the frame before, which pipelining still has in flight.
+// A view's colour and depth (its picture), and its readback buffers, a slot for each frame in
+// flight, used in turn. With a picture per slot (pictures = kReadbackSlots), a frame draws into the
+// picture whose last frame has been read back, so that a copy into it at the frame's start
+// (CockpitPass's kept cabin) finds nothing still drawing into it: on llvmpipe it would wait for the
+// frame before, which pipelining still has in flight. Without (1), the slots share one picture.
 struct ViewTarget {
   int width = 0;
   int height = 0;
-  std::array<Texture, kReadbackSlots> colour;
+  int pictures = 1;
+  std::array<Texture, kReadbackSlots> colour;  // the first `pictures` of them
   std::array<Texture, kReadbackSlots> depth;
   std::array<Framebuffer, kReadbackSlots> fbo;
   std::array<Buffer, kReadbackSlots> pbo;
@@ -52,8 +56,9 @@ struct ViewTarget {
   int next_slot = 0;
   std::unique_ptr<GroundTruthTarget> truth;  // made for the first frame that asks for outputs
 
-  ViewTarget(int w, int h);
+  ViewTarget(int w, int h, int pictures);
   ~ViewTarget();
+  int picture(int slot) const { return slot % pictures; }  // the picture slot `slot` draws into
   ViewTarget(const ViewTarget&) = delete;
   ViewTarget& operator=(const ViewTarget&) = delete;
   bool busy() const;

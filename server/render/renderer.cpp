@@ -109,6 +109,7 @@ struct Renderer::Impl {
   // drops' inversion and brightening over the grass kept or better than at 1, and 1.5 lost the
   // brightening); on a GPU 1 and 1 (square, as sharp as the blur).
   int min_glass_layer_scale = 1;
+  int view_pictures = 1;  // a view's colour and depth targets (ViewTarget::pictures)
   double glass_layer_widening = 1.0;
   std::optional<std::array<std::vector<glm::vec3>, EnvironmentProbe::kFaces>> fixed_environment;
 
@@ -355,7 +356,7 @@ struct Renderer::Impl {
   // The ground truth's clean frame: the view as it stands (before its water).
   void take_clean(ViewFrame::State& v) {
     timed("clean_copy", [&] {
-      glCopyImageSubData(v.target->colour[v.slot].id(), GL_TEXTURE_2D, 0, 0, 0, 0,
+      glCopyImageSubData(v.resources.view_colour.texture, GL_TEXTURE_2D, 0, 0, 0, 0,
                          v.target->truth->clean.id(), GL_TEXTURE_2D, 0, 0, 0, 0, v.spec.width,
                          v.spec.height, 1);
     });
@@ -395,10 +396,11 @@ struct Renderer::Impl {
     if (v.wants_clean && pass == static_cast<Pass*>(passes.glass_composite) &&
         pass->wanted(frame)) {
       timed("clean_blades", [&] {
-        glBindFramebuffer(GL_FRAMEBUFFER, v.target->truth->clean_fbo[v.slot].id());
+        glBindFramebuffer(GL_FRAMEBUFFER,
+                          v.target->truth->clean_fbo[v.target->picture(v.slot)].id());
         apply(pass->decl().state);
         passes.glass_composite->draw_blades(frame);
-        glBindFramebuffer(GL_FRAMEBUFFER, v.target->fbo[v.slot].id());
+        glBindFramebuffer(GL_FRAMEBUFFER, v.resources.view_fbo);
       });
     }
   }
@@ -444,6 +446,8 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
   impl->passes = make_view_passes(*impl->shared, *impl->block, *impl->lamps, smoothing,
                                   options.road_at_half.value_or(cpu_rasterizer),
                                   options.keep_cabin.value_or(cpu_rasterizer));
+  // Kept cabins are copied into a picture of the view's that nothing draws into any longer.
+  impl->view_pictures = options.keep_cabin.value_or(cpu_rasterizer) ? kReadbackSlots : 1;
   if (glGetError() != GL_NO_ERROR) throw std::runtime_error("GL error while creating the renderer");
   return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
 }
@@ -511,7 +515,10 @@ std::array<std::uint32_t, 3> Renderer::last_spray_drawn() const {
 const std::vector<PassTiming>& Renderer::last_pass_timings() const { return impl_->timings; }
 std::uint32_t Renderer::last_rain_streaks() const { return impl_->rain_streaks; }
 
-void Renderer::release_shared_targets() { impl_->transients.clear(); }
+void Renderer::release_shared_targets() {
+  impl_->transients.clear();
+  impl_->passes.cockpit->release();
+}
 
 void Renderer::set_fixed_environment(std::optional<std::array<std::vector<glm::vec3>, 6>> faces,
                                      int face_size) {
@@ -558,7 +565,7 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
   if (new_target) {
     if (target && target->busy())
       throw std::logic_error("render target resized with a readback in flight");
-    target = std::make_unique<ViewTarget>(spec.width, spec.height);
+    target = std::make_unique<ViewTarget>(spec.width, spec.height, m.view_pictures);
   }
   const int slot = target->next_slot;
   target->next_slot = (slot + 1) % kReadbackSlots;
@@ -575,7 +582,8 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
   // Ground truth: the clean frame (for itself or the water mask) and the depth.
   v.wants_clean = spec.outputs.needs_clean();
   if (spec.outputs.any() && !target->truth) {
-    target->truth = std::make_unique<GroundTruthTarget>(spec.width, spec.height, target->depth);
+    target->truth = std::make_unique<GroundTruthTarget>(spec.width, spec.height, target->depth,
+                                                        target->pictures);
   }
   v.frame.emplace(FrameContext{
       scene, spec, camera, atmosphere_from(scene.weather),
@@ -588,9 +596,10 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
       detail_distance_scale(2.0 * camera.tan_half_fov_y / std::max(spec.height, 1));
   if (new_target) m.prepare(frame);
   FrameResources& resources = v.resources;
-  resources.view_fbo = target->fbo[slot].id();
-  resources.view_colour = {target->colour[slot].id(), spec.width, spec.height};
-  resources.view_depth = {target->depth[slot].id(), spec.width, spec.height};
+  const int picture = target->picture(slot);
+  resources.view_fbo = target->fbo[picture].id();
+  resources.view_colour = {target->colour[picture].id(), spec.width, spec.height};
+  resources.view_depth = {target->depth[picture].id(), spec.width, spec.height};
   const bool client = spec.background == sim::Background::kClient;
   v.fixed = m.fixed_environment && spec.view == sim::View::kCockpit && !client;
   v.passes = v.fixed ? &m.passes.fixed_environment_cockpit : &m.view_list(spec);
@@ -640,7 +649,7 @@ PendingReadback Renderer::end(ViewFrame& view) {
   ViewTarget& target = *v.target;
   m.written = v.written;
   m.timings = std::move(v.timings);
-  glBindFramebuffer(GL_FRAMEBUFFER, target.fbo[v.slot].id());
+  glBindFramebuffer(GL_FRAMEBUFFER, v.resources.view_fbo);
   glViewport(0, 0, spec.width, spec.height);
   // Passes left to draw (the glass's) after another view began or ended since this one began:
   // this one's lamps, blocks and sky again; its lamp map only if a face of the environment is
@@ -663,8 +672,8 @@ PendingReadback Renderer::end(ViewFrame& view) {
                           spec.width, spec.height,  spec.outputs, frame.camera.near_m};
   m.timed("readback_start", [&] {
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glNamedFramebufferReadBuffer(target.fbo[slot].id(), GL_COLOR_ATTACHMENT0);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, target.fbo[slot].id());
+    glNamedFramebufferReadBuffer(v.resources.view_fbo, GL_COLOR_ATTACHMENT0);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, v.resources.view_fbo);
     glBindBuffer(GL_PIXEL_PACK_BUFFER, target.pbo[slot].id());
     glReadPixels(0, 0, spec.width, spec.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
     if (spec.outputs.depth) {
@@ -672,8 +681,9 @@ PendingReadback Renderer::end(ViewFrame& view) {
       glReadPixels(0, 0, spec.width, spec.height, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
     }
     if (v.wants_clean) {
-      glNamedFramebufferReadBuffer(target.truth->clean_fbo[slot].id(), GL_COLOR_ATTACHMENT0);
-      glBindFramebuffer(GL_READ_FRAMEBUFFER, target.truth->clean_fbo[slot].id());
+      glNamedFramebufferReadBuffer(target.truth->clean_fbo[target.picture(slot)].id(),
+                                   GL_COLOR_ATTACHMENT0);
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, target.truth->clean_fbo[target.picture(slot)].id());
       glBindBuffer(GL_PIXEL_PACK_BUFFER, target.truth->clean_pbo[slot].id());
       glReadPixels(0, 0, spec.width, spec.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
     }

@@ -18,10 +18,11 @@ struct SessionCost {
 // this one if none. Alone on an empty server, any session passes the pixel-rate budget.
 constexpr double kLockstepNominalFps = 30.0;
 // Measured on the server (docs/operations.md, Admission): resident memory per pixel of a view (its
-// targets, the glass passes' targets, readback buffers, the encoder's copy and output) and per
-// session (the simulation, the glass water map, the session's GL state); and, beside those 16 MB,
-// the water's surface on the GPU (some 3 MB in heavy rain) and the environment probe (1.2 MB).
-constexpr double kBytesPerViewPixel = 20.0;
+// targets, the glass passes' targets, readback buffers, the encoder's copy and output; on llvmpipe
+// a second colour and depth and the kept cabin's picture, 16 of the 36) and per session (the
+// simulation, the glass water map, the session's GL state); and, beside those 16 MB, the water's
+// surface on the GPU (some 3 MB in heavy rain) and the environment probe (1.2 MB).
+constexpr double kBytesPerViewPixel = 36.0;
 constexpr double kBytesPerSession = 20.0 * 1024 * 1024;
 // A view that asks for ground truth (sim::Outputs), per pixel, counted from what it holds: the
 // clean frame's texture, two readback buffers and the encoder's copy (16 bytes), the depth's two

@@ -65,6 +65,7 @@ CockpitPass::CockpitPass(SharedResources&, bool keep_pictures)
       uniforms_(program_),
       u_clip_from_car_(program_.uniform("u_clip_from_car")),
       u_eye_(program_.uniform("u_eye")),
+      u_up_(program_.uniform("u_up")),
       u_sun_dir_(program_.uniform("u_sun_dir")),
       u_ambient_(program_.uniform("u_ambient")),
       u_sun_radiance_(program_.uniform("u_sun_radiance")),
@@ -73,6 +74,8 @@ CockpitPass::CockpitPass(SharedResources&, bool keep_pictures)
       keep_pictures_(keep_pictures) {}
 
 CockpitPass::~CockpitPass() = default;
+
+void CockpitPass::release() { kept_.clear(); }
 
 const ModelMesh& CockpitPass::mesh_of(const FrameContext& frame, std::uint64_t* serial) {
   // The cabin is built around the scene's glass (remade in the rare case that it changes).
@@ -104,16 +107,21 @@ CockpitPass::Key CockpitPass::key_of(const FrameContext& frame, const ModelMesh&
   k.height = frame.spec.height;
   const glm::mat4 clip(glm::dmat4(frame.camera.projection) * frame.camera.view_vehicle);
   const glm::dmat3 to_car = glm::transpose(glm::dmat3(sim::vehicle_to_world(frame.scene.vehicle)));
-  glm::vec3 light[5] = {glm::vec3(frame.camera.position_vehicle),
+  glm::vec3 light[6] = {glm::vec3(frame.camera.position_vehicle),
+                        glm::vec3(to_car * glm::dvec3(0.0, 0.0, 1.0)),
                         glm::vec3(to_car * glm::dvec3(frame.atmosphere.sun_direction)),
-                        frame.atmosphere.ambient, frame.atmosphere.sun_radiance,
+                        frame.atmosphere.ambient,
+                        frame.atmosphere.sun_radiance,
                         frame.atmosphere.sky_horizon};
   if (keep_pictures_) {
     light[1] = rounded_direction(light[1]);
-    for (int i = 2; i < 5; ++i) light[i] = rounded_relative(light[i]);
+    light[2] = rounded_direction(light[2]);
+    for (int i = 3; i < 6; ++i) light[i] = rounded_relative(light[i]);
   }
+  // Without sun (by night), its direction is nothing to the picture: not in the key.
+  if (light[4] == glm::vec3(0.0f)) light[2] = glm::vec3(0.0f);
   std::memcpy(k.numbers.data(), glm::value_ptr(clip), 16 * sizeof(float));
-  for (int i = 0; i < 5; ++i) std::memcpy(&k.numbers[16 + 3 * i], &light[i], 3 * sizeof(float));
+  for (int i = 0; i < 6; ++i) std::memcpy(&k.numbers[16 + 3 * i], &light[i], 3 * sizeof(float));
   return k;
 }
 
@@ -126,14 +134,16 @@ void CockpitPass::draw(const ModelMesh& mesh, const Key& key) {
   };
   u_clip_from_car_.set(clip);
   u_eye_.set(at(0));
-  u_sun_dir_.set(at(1));
-  u_ambient_.set(at(2));
-  u_sun_radiance_.set(at(3));
-  u_sky_horizon_.set(at(4));
+  u_up_.set(at(1));
+  u_sun_dir_.set(at(2));
+  u_ambient_.set(at(3));
+  u_sun_radiance_.set(at(4));
+  u_sky_horizon_.set(at(5));
   mesh.draw(uniforms_, glm::mat4(1.0f), 0.0, false);
 }
 
 bool CockpitPass::restore(const FrameContext& frame, const FrameResources& resources) {
+  restored_into_ = 0;  // (one left by a frame that failed before its cabin)
   if (!keep_pictures_) return false;
   std::uint64_t serial = 0;
   const ModelMesh& mesh = mesh_of(frame, &serial);

@@ -34,6 +34,8 @@ class CockpitPass final : public Pass {
   // and nothing drawing into it still from an earlier one: the kept picture of this frame's cabin
   // copied into the view's colour and depth, if there is one ready. Then execute() draws nothing.
   bool restore(const FrameContext& frame, const FrameResources& resources);
+  // Lets go of the kept pictures (Renderer::release_shared_targets).
+  void release();
 
   // How many frames restored the cabin, and drew it (and how many of those kept the picture).
   struct Counts {
@@ -48,7 +50,8 @@ class CockpitPass final : public Pass {
     const ModelMesh* mesh = nullptr;
     std::uint64_t mesh_serial = 0;  // (a named model's address may be another's later)
     int width = 0, height = 0;
-    std::array<float, 16 + 5 * 3> numbers{};  // clip from car, eye, sun, ambient, sun, horizon
+    // Clip from car; the eye, up, the sun's direction, ambient, the sun's radiance, the horizon's.
+    std::array<float, 16 + 6 * 3> numbers{};
     bool operator==(const Key&) const = default;
   };
   struct Kept;
@@ -62,7 +65,7 @@ class CockpitPass final : public Pass {
                        {DepthTest::kNearer, true, Blend::kOff}};
   ShaderProgram program_;
   ModelUniforms uniforms_;
-  Uniform u_clip_from_car_, u_eye_, u_sun_dir_, u_ambient_, u_sun_radiance_, u_sky_horizon_;
+  Uniform u_clip_from_car_, u_eye_, u_up_, u_sun_dir_, u_ambient_, u_sun_radiance_, u_sky_horizon_;
   sim::GlassConfig built_for_;
   ModelMesh interior_;  // the built-in cabin round the glass
   std::uint64_t interior_serial_ = 1;
