@@ -381,6 +381,45 @@ TEST(WaterTest, ABladeSweepsExactlyTheDropsATestOfEveryDropWouldTake) {
   }
 }
 
+// The suspension search reads a flag per cell that the mesh model keeps as its drops grow, move,
+// fuse, leave trails that shrink and go: at every step of a run of flowing drops, its answer is
+// what a look at every drop gives (a drop at or above the critical radius whose cell lies within
+// the search square).
+TEST(WaterTest, TheSuspensionSearchSeesWhatATestOfEveryDropWouldSee) {
+  const WindshieldConfig config;
+  const WaterConfig& w = config.water;
+  RandomStream random(23, 2);
+  MeshModel mesh(config, 77);
+  int near = 0, checked = 0;
+  for (int step = 0; step < 240; ++step) {  // 2 s
+    for (int k = 0; k < 60; ++k) {          // rain, heavy, some of it in large drops
+      const glm::dvec2 p(random.uniform(0.0, 1520.0), random.uniform(0.0, 760.0));
+      if (config.glass.contains(p)) mesh.place(p, random.uniform(0.001, 25.0), nullptr);
+    }
+    mesh.step(kDt, glm::dvec2(0.0, 3.0));
+    if (step % 20 != 19) continue;
+    for (int k = 0; k < 2000; ++k) {
+      const glm::dvec2 p(random.uniform(0.0, 1520.0), random.uniform(0.0, 760.0));
+      const int reach = w.suspension_cells / 2;
+      const int cu = static_cast<int>(std::floor(p.x / w.cell_mm));
+      const int cv = static_cast<int>(std::floor(p.y / w.cell_mm));
+      bool expected = false;
+      for (const MeshModel::Drop& d : mesh.drops()) {
+        if (!d.alive || d.radius < w.critical_radius_mm) continue;
+        const int du = static_cast<int>(std::floor(d.pos.x / w.cell_mm)) - cu;
+        const int dv = static_cast<int>(std::floor(d.pos.y / w.cell_mm)) - cv;
+        if (std::abs(du) <= reach && std::abs(dv) <= reach) expected = true;
+      }
+      ASSERT_EQ(mesh.holds_critical_drop_near(p), expected)
+          << "step " << step << " at " << p.x << ", " << p.y;
+      near += expected;
+      ++checked;
+    }
+  }
+  EXPECT_GT(near, checked / 20);  // both answers are tested
+  EXPECT_LT(near, checked - checked / 20);
+}
+
 TEST(WaterTest, AParticlePressedByManyPartsWithoutOvershooting) {
   // One particle with six others each overlapping it by half a diameter, fanned out over its
   // upper right: it gives way by about an overlap, not by the six overlaps summed.
