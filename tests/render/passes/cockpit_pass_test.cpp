@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "server/model/default_models.hpp"
+#include "server/model/gltf_model.hpp"
 #include "server/render/renderer.hpp"
 #include "tests/render/render_fixture.hpp"
 #include "tests/render/windshield_fixture.hpp"
@@ -60,6 +62,35 @@ TEST(CockpitPassTest, AKeptCabinIsTheDrawnCabin) {
   EXPECT_TRUE(sun_restored.pixels == sun_drawn.pixels);
   EXPECT_TRUE(rain_again.pixels == rain_drawn.pixels);
   EXPECT_FALSE(sun_drawn.pixels == rain_drawn.pixels);
+}
+
+// A cabin the session names (a glTF model) is kept apart from the built-in one, and another model
+// is drawn anew, even where it takes the place (and the address) of one let go of.
+TEST(CockpitPassTest, ANamedCabinIsKeptApartAndAnotherIsDrawnAnew) {
+  auto renderer = Renderer::create({.keep_cabin = true});
+  sim::SceneState s = rainy();
+  draw(*renderer, s);  // the built-in cabin, kept
+  draw(*renderer, s);  // and restored
+  auto named = [&s] {
+    return std::make_shared<const model::VehicleModel>(model::read_gltf(
+        model::write_glb(model::default_cabin(s.glass)), model::ModelKind::kCabin));
+  };
+  s.ego.cabin_model = named();
+  const RgbaImage drawn = draw(*renderer, s);
+  Renderer::CabinCounts c = renderer->cabin_counts();
+  EXPECT_EQ(c.drawn, 2u);
+  EXPECT_EQ(c.kept, 2u);
+  EXPECT_TRUE(draw(*renderer, s).pixels == drawn.pixels);
+  EXPECT_EQ(renderer->cabin_counts().restored, 2u);
+  for (int k = 0; k < 3; ++k) {  // a new model each time, the last one let go of first
+    s.ego.cabin_model.reset();
+    s.ego.cabin_model = named();
+    draw(*renderer, s);
+  }
+  c = renderer->cabin_counts();
+  EXPECT_EQ(c.drawn, 5u);
+  EXPECT_EQ(c.restored, 2u);
+  EXPECT_EQ(c.kept, 3u);  // the first new one; the next two wait for it to be used (four draws)
 }
 
 // Where the light changes every frame, a picture is kept at most every few draws, not each frame
