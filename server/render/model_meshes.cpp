@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 
 #include <glm/gtc/constants.hpp>
@@ -61,8 +62,16 @@ ModelUniforms::ModelUniforms(const ShaderProgram& program)
       wheel_turn(program.uniform("u_wheel_turn")),
       textured(program.uniform("u_textured")) {}
 
+namespace {
+std::uint64_t next_mesh_serial() {
+  static std::atomic<std::uint64_t> made{0};
+  return ++made;
+}
+}  // namespace
+
 ModelMesh::ModelMesh(const model::VehicleModel& m)
-    : mesh(m.mesh),
+    : serial(next_mesh_serial()),
+      mesh(m.mesh),
       fixed(m.fixed_index_count),
       bonnet(m.bonnet_index_count),
       wheels(m.wheels),

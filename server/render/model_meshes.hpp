@@ -33,6 +33,9 @@ struct ModelMesh {
   static constexpr int kMaxWheels = 16;  // MAX_WHEELS in mesh_vertex.glsl
 
   explicit ModelMesh(const model::VehicleModel& m);
+  // Which upload this is, never reused (an address may be another's later): what a picture of it
+  // is kept under (CockpitPass).
+  std::uint64_t serial = 0;
   Mesh mesh;
   std::uint32_t fixed = 0, bonnet = 0;
   std::vector<model::Wheel> wheels;

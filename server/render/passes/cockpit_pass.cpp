@@ -77,32 +77,21 @@ CockpitPass::~CockpitPass() = default;
 
 void CockpitPass::release() { kept_.clear(); }
 
-const ModelMesh& CockpitPass::mesh_of(const FrameContext& frame, std::uint64_t* serial) {
+const ModelMesh& CockpitPass::mesh_of(const FrameContext& frame) {
   // The cabin is built around the scene's glass (remade in the rare case that it changes).
   const sim::GlassConfig& glass = frame.scene.glass;
   if (!model::same_cabin(glass, built_for_)) {
     built_for_ = glass;
     interior_ = ModelMesh(model::default_cabin(built_for_));
-    interior_serial_ = ++serials_;
   }
   named_.prune();
-  std::erase_if(named_serials_, [](const auto& n) { return n.second.model.expired(); });
   const sim::ModelPtr& cabin = frame.scene.ego.cabin_model;
-  if (!cabin) {
-    *serial = interior_serial_;
-    return interior_;
-  }
-  Named& n = named_serials_[cabin.get()];
-  if (n.model.lock() != cabin) n = {cabin, ++serials_};
-  *serial = n.serial;
-  return named_.get(cabin);
+  return cabin ? named_.get(cabin) : interior_;
 }
 
-CockpitPass::Key CockpitPass::key_of(const FrameContext& frame, const ModelMesh& mesh,
-                                     std::uint64_t serial) const {
+CockpitPass::Key CockpitPass::key_of(const FrameContext& frame, const ModelMesh& mesh) const {
   Key k;
-  k.mesh = &mesh;
-  k.mesh_serial = serial;
+  k.mesh = mesh.serial;
   k.width = frame.spec.width;
   k.height = frame.spec.height;
   const glm::mat4 clip(glm::dmat4(frame.camera.projection) * frame.camera.view_vehicle);
@@ -145,9 +134,8 @@ void CockpitPass::draw(const ModelMesh& mesh, const Key& key) {
 bool CockpitPass::restore(const FrameContext& frame, const FrameResources& resources) {
   restored_into_ = 0;  // (one left by a frame that failed before its cabin)
   if (!keep_pictures_) return false;
-  std::uint64_t serial = 0;
-  const ModelMesh& mesh = mesh_of(frame, &serial);
-  const Key key = key_of(frame, mesh, serial);
+  const ModelMesh& mesh = mesh_of(frame);
+  const Key key = key_of(frame, mesh);
   auto it = std::find_if(kept_.begin(), kept_.end(), [&](const auto& k) { return k->key == key; });
   if (it == kept_.end() || !(*it)->ready()) return false;
   const Kept& kept = **it;
@@ -168,9 +156,8 @@ void CockpitPass::execute(const FrameContext& frame, const FrameResources& resou
     return;
   }
   restored_into_ = 0;
-  std::uint64_t serial = 0;
-  const ModelMesh& mesh = mesh_of(frame, &serial);
-  const Key key = key_of(frame, mesh, serial);
+  const ModelMesh& mesh = mesh_of(frame);
+  const Key key = key_of(frame, mesh);
   draw(mesh, key);
   ++counts_.drawn;
   if (!keep_pictures_ ||

@@ -2,7 +2,6 @@
 
 #include <array>
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <vector>
 
@@ -19,8 +18,9 @@ namespace downpour::render {
 // It is drawn in the car's frame (cabin.vert) and lit by the atmosphere's light turned into that
 // frame, so that for a camera fixed in the car its picture changes only with the light. Where the
 // renderer keeps its picture (llvmpipe, which pays as much for a cabin pixel as for any other: 1.5
-// ms of a 640x360 frame, 5 at 1280x720), the light is rounded (a sun direction to 1/64, radiances
-// to 1/128 of themselves), the cabin's picture on a cleared view (colour and depth) is kept under
+// ms of a 640x360 frame, 5 at 1280x720), the light is rounded (the world's up and the sun's
+// direction to 1/64 a component, radiances to 1/128 of themselves; no sun's direction where there
+// is no sun), the cabin's picture on a cleared view (colour and depth) is kept under
 // everything it was drawn with, and a view whose frame would draw the same gets it back by a copy
 // in place of its clear and the draw (restore()). Drawn or copied, the pixels are the same.
 class CockpitPass final : public Pass {
@@ -47,16 +47,15 @@ class CockpitPass final : public Pass {
   // What a picture of the cabin is drawn with: the mesh, the view's size, the camera in the car's
   // frame and the light; equal keys, equal pictures.
   struct Key {
-    const ModelMesh* mesh = nullptr;
-    std::uint64_t mesh_serial = 0;  // (a named model's address may be another's later)
+    std::uint64_t mesh = 0;  // ModelMesh::serial
     int width = 0, height = 0;
     // Clip from car; the eye, up, the sun's direction, ambient, the sun's radiance, the horizon's.
     std::array<float, 16 + 6 * 3> numbers{};
     bool operator==(const Key&) const = default;
   };
   struct Kept;
-  Key key_of(const FrameContext& frame, const ModelMesh& mesh, std::uint64_t serial) const;
-  const ModelMesh& mesh_of(const FrameContext& frame, std::uint64_t* serial);
+  Key key_of(const FrameContext& frame, const ModelMesh& mesh) const;
+  const ModelMesh& mesh_of(const FrameContext& frame);
   void draw(const ModelMesh& mesh, const Key& key);
 
   const PassDecl decl_{"cockpit",
@@ -68,14 +67,7 @@ class CockpitPass final : public Pass {
   Uniform u_clip_from_car_, u_eye_, u_up_, u_sun_dir_, u_ambient_, u_sun_radiance_, u_sky_horizon_;
   sim::GlassConfig built_for_;
   ModelMesh interior_;  // the built-in cabin round the glass
-  std::uint64_t interior_serial_ = 1;
-  ModelMeshes named_;  // the cabin models sessions name
-  struct Named {
-    std::weak_ptr<const model::VehicleModel> model;
-    std::uint64_t serial = 0;
-  };
-  std::map<const model::VehicleModel*, Named> named_serials_;
-  std::uint64_t serials_ = 1;
+  ModelMeshes named_;   // the cabin models sessions name
   bool keep_pictures_;
   std::vector<std::unique_ptr<Kept>> kept_;  // the latest few, the most recently used first
   GLuint restored_into_ = 0;                 // the view colour restore() filled, until execute()
