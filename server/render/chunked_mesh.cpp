@@ -133,7 +133,11 @@ int ChunkedMesh::level_for(const Chunk& chunk, const glm::mat4& view_proj, const
   if (from_m > 0.0f && glm::length(glm::max(glm::abs(camera - chunk.bounds_min),
                                             glm::abs(camera - chunk.bounds_max))) < from_m)
     return -1;
-  const float distance = nearest * distance_scale;
+  // (Of the part drawn: a chunk that reaches under the camera but is drawn only from `from_m` on,
+  // as the road's far part, takes the level of its nearest drawn point. Each triangle costs
+  // llvmpipe about 0.4 us however little of it is drawn: the chunk under a 640x360 ROAD camera,
+  // drawn from 17 m at its finest level, was 1,540 of the far road's 3,920 triangles.)
+  const float distance = std::max(nearest, from_m) * distance_scale;
   if (distance >= max_distance_m_) return -1;
   std::size_t level = 0;
   while (level < level_distances_m_.size() && level + 1 < chunk.levels.size() &&
@@ -234,10 +238,10 @@ void ChunkedMesh::draw_visible(const glm::mat4& view_proj, const glm::vec3& came
   mesh_.multi_draw(counts_.data(), offsets_.data(), static_cast<GLsizei>(counts_.size()));
 }
 
-std::size_t ChunkedMesh::visible_triangles(const glm::mat4& view_proj,
-                                           const glm::vec3& camera) const {
+std::size_t ChunkedMesh::visible_triangles(const glm::mat4& view_proj, const glm::vec3& camera,
+                                           float distance_scale, float from_m, float to_m) const {
   std::size_t triangles = 0;
-  for_each_drawn(view_proj, camera, 1.0f, 0.0f, 1e30f,
+  for_each_drawn(view_proj, camera, distance_scale, from_m, to_m,
                  [&](const Range& r) { triangles += r.count / 3; });
   return triangles;
 }

@@ -34,8 +34,9 @@ class ChunkedMesh {
   ChunkedMesh(const SkirtedChunks& chunks, std::vector<float> level_distances_m,
               float max_distance_m = 1e30f);
   // Draws the chunks whose bounds meet the view's frustum, and reach from `from_m` to `to_m` of the
-  // camera, with the bound program, each at the level for its distance times distance_scale, in
-  // one call. A chunk outside [from_m, to_m) counts as not drawn for its neighbours' skirts.
+  // camera, with the bound program, each at the level for its distance (from_m where its nearest
+  // point is nearer) times distance_scale, in one call. A chunk outside [from_m, to_m) counts as
+  // not drawn for its neighbours' skirts.
   void draw_visible(const glm::mat4& view_proj, const glm::vec3& camera,
                     float distance_scale = 1.0f, float from_m = 0.0f, float to_m = 1e30f) const;
   // Where on the screen the chunks that draw_visible() would draw may cover, up to max_w of the
@@ -45,7 +46,9 @@ class ChunkedMesh {
                           float distance_scale = 1.0f, float from_m = 0.0f, float to_m = 1e30f,
                           float max_w = 1e30f) const;
   // The triangles draw_visible() would draw (for tests and benchmarks).
-  std::size_t visible_triangles(const glm::mat4& view_proj, const glm::vec3& camera) const;
+  std::size_t visible_triangles(const glm::mat4& view_proj, const glm::vec3& camera,
+                                float distance_scale = 1.0f, float from_m = 0.0f,
+                                float to_m = 1e30f) const;
 
  private:
   struct Range {

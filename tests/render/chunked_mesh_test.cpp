@@ -67,6 +67,28 @@ TEST_F(ChunkedMeshTest, UpToADepthTheBoundsEndThere) {
   EXPECT_LT(none.w, none.y);
 }
 
+TEST_F(ChunkedMeshTest, AChunkDrawnFromADistanceTakesTheLevelOfThatDistance) {
+  // From 5 m behind the camera to 60 m ahead: level 0 a grid of 4 x 4 quads, level 1 one quad,
+  // drawn at level 1 from 20 m.
+  MeshData fine;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      const MeshData q = ground(-5.0f + 16.25f * i, -5.0f + 16.25f * (i + 1), -4.0f + 2.0f * j,
+                                -4.0f + 2.0f * (j + 1));
+      const auto first = static_cast<std::uint32_t>(fine.vertices.size());
+      for (const auto& v : q.vertices) fine.vertices.push_back(v);
+      for (const std::uint32_t k : q.indices) fine.indices.push_back(first + k);
+    }
+  }
+  const ChunkedMesh mesh({{fine, ground(-5.0f, 60.0f, -4.0f, 4.0f)}}, {20.0f});
+  EXPECT_EQ(mesh.visible_triangles(view_proj, camera), 32u);  // (its nearest point under it)
+  EXPECT_EQ(mesh.visible_triangles(view_proj, camera, 1.0f, 10.0f), 32u);
+  // From 30 m on, only its part beyond 30 m is drawn: the coarse level.
+  EXPECT_EQ(mesh.visible_triangles(view_proj, camera, 1.0f, 30.0f), 2u);
+  // And from 10 m at twice the distances.
+  EXPECT_EQ(mesh.visible_triangles(view_proj, camera, 2.0f, 10.0f), 2u);
+}
+
 TEST_F(ChunkedMeshTest, NoChunkInViewHasNoBounds) {
   const ChunkedMesh mesh({{ground(-30.0f, -20.0f, -2.0f, 2.0f)}}, {1e30f});
   const glm::vec4 b = mesh.screen_bounds(view_proj, camera);

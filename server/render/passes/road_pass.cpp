@@ -115,8 +115,10 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
   const glm::mat4 view_proj = frame.camera.projection * frame.camera.view;
   // (The far part's triangles are small, and llvmpipe shades whole blocks of pixels around each:
   // the far part at the coarser levels from a quarter of their distances took 0.84-0.86 of the
-  // time in turn with the view's own, in a 640x360 ROAD. The near part takes the same levels, so
-  // that both draw the same surface where they meet.)
+  // time in turn with the view's own, in a 640x360 ROAD. The near part takes the same scale. The
+  // chunk that reaches across the split may be finer in the near part, which goes on from its
+  // camera, than in the far one (ChunkedMesh::draw_visible): on a curve their edges then meet a
+  // chord's sag apart, 3 cm where 8 m rows bend around 300 m, under a pixel at the split.)
   const float detail =
       frame.detail_distance_scale * (part_ == RoadPart::kWhole ? 1.0f : kPartsDetailScale);
   // This part's range of the chunks' distances (m from the camera), and its plane on the view's
