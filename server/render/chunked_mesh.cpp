@@ -147,53 +147,6 @@ int ChunkedMesh::level_for(const Chunk& chunk, const glm::mat4& view_proj, const
   return static_cast<int>(level);
 }
 
-glm::vec4 ChunkedMesh::screen_bounds(const glm::mat4& view_proj, const glm::vec3& camera,
-                                     float distance_scale, float from_m, float to_m,
-                                     float max_w) const {
-  // Each drawn chunk's box, its edges clipped to w in [kNearW, max_w] (w is the view's depth),
-  // projected.
-  constexpr float kNearW = 1e-3f;
-  glm::vec2 lo(1.0f), hi(-1.0f);
-  auto include = [&](const glm::vec4& p) {
-    const glm::vec2 ndc = glm::vec2(p) / p.w;
-    lo = glm::min(lo, ndc);
-    hi = glm::max(hi, ndc);
-  };
-  for (const Chunk& chunk : chunks_) {
-    if (level_for(chunk, view_proj, camera, distance_scale, from_m, to_m) < 0) continue;
-    std::array<glm::vec4, 8> corner;
-    for (int i = 0; i < 8; ++i) {
-      const glm::vec3 p((i & 1) ? chunk.bounds_max.x : chunk.bounds_min.x,
-                        (i & 2) ? chunk.bounds_max.y : chunk.bounds_min.y,
-                        (i & 4) ? chunk.bounds_max.z : chunk.bounds_min.z);
-      corner[i] = view_proj * glm::vec4(p, 1.0f);
-    }
-    // The twelve edges (corners one bit apart), each clipped to the range of w.
-    for (int i = 0; i < 8; ++i) {
-      for (int bit = 1; bit < 8; bit <<= 1) {
-        if (i & bit) continue;
-        const glm::vec4 &a = corner[i], &b = corner[i | bit];
-        float t0 = 0.0f, t1 = 1.0f;
-        for (const auto& [bound, below] : {std::pair{kNearW, false}, std::pair{max_w, true}}) {
-          // Keep w >= bound (or w <= bound where `below`).
-          const float da = below ? bound - a.w : a.w - bound,
-                      db = below ? bound - b.w : b.w - bound;
-          if (da < 0.0f && db < 0.0f)
-            t0 = 2.0f;  // (none of it)
-          else if (da < 0.0f)
-            t0 = std::max(t0, da / (da - db));
-          else if (db < 0.0f)
-            t1 = std::min(t1, da / (da - db));
-        }
-        if (t0 > t1) continue;
-        include(glm::mix(a, b, t0));
-        include(glm::mix(a, b, t1));
-      }
-    }
-  }
-  return {glm::clamp(lo, -1.0f, 1.0f), glm::clamp(hi, -1.0f, 1.0f)};
-}
-
 template <typename Fn>
 void ChunkedMesh::for_each_drawn(const glm::mat4& view_proj, const glm::vec3& camera,
                                  float distance_scale, float from_m, float to_m, Fn&& fn) const {

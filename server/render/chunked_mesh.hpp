@@ -39,12 +39,6 @@ class ChunkedMesh {
   // not drawn for its neighbours' skirts.
   void draw_visible(const glm::mat4& view_proj, const glm::vec3& camera,
                     float distance_scale = 1.0f, float from_m = 0.0f, float to_m = 1e30f) const;
-  // Where on the screen the chunks that draw_visible() would draw may cover, up to max_w of the
-  // view's depth (view_proj's w): their boxes' rectangle in normalized device coordinates,
-  // (x0, y0, x1, y1), clipped to the screen; x1 < x0 where none.
-  glm::vec4 screen_bounds(const glm::mat4& view_proj, const glm::vec3& camera,
-                          float distance_scale = 1.0f, float from_m = 0.0f, float to_m = 1e30f,
-                          float max_w = 1e30f) const;
   // The triangles draw_visible() would draw (for tests and benchmarks).
   std::size_t visible_triangles(const glm::mat4& view_proj, const glm::vec3& camera,
                                 float distance_scale = 1.0f, float from_m = 0.0f,

@@ -44,7 +44,7 @@ ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
   if (road_at_half) {
     p.road_layer = own(std::make_unique<RoadPass>(shared, RoadPart::kNearInLayer));
     p.road_far = own(std::make_unique<RoadPass>(shared, RoadPart::kFar));
-    chase_road = {p.road_layer, own(std::make_unique<RoadCompositePass>(shared, *p.road_layer)),
+    chase_road = {p.road_layer, own(std::make_unique<RoadCompositePass>(*p.road_layer)),
                   p.road_far};
   }
   Pass* terrain = own(std::make_unique<TerrainPass>(shared));

@@ -137,8 +137,7 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
     const float tan_x = tan_y * static_cast<float>(frame.spec.width) /
                         static_cast<float>(std::max(frame.spec.height, 1));
     to_m = end * std::sqrt(1.0f + tan_x * tan_x + tan_y * tan_y);
-    screen_bounds_ =
-        frame.world->road.screen_bounds(view_proj, frame.camera.position, detail, 0.0f, to_m, end);
+    near_draw_ = {detail, to_m};
   } else if (part_ == RoadPart::kFar) {
     depth_clip = glm::vec4(n, w0 - split);
     from_m = split;
@@ -174,37 +173,28 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
                                  relief_here ? std::max(reach, from_m) : from_m, to_m);
 }
 
-RoadCompositePass::RoadCompositePass(SharedResources& shared, const RoadPass& layer)
+RoadCompositePass::RoadCompositePass(const RoadPass& layer)
     : decl_{std::string(kRoadPassNames[2]),
             {Resource::kRoadLayer},
             {Resource::kViewColour, Resource::kViewDepth},
-            {DepthTest::kNearer, true, Blend::kOff}},
-      shared_(shared),
+            {DepthTest::kNearer, true, Blend::kOff, true, false, 0b100}},
       layer_(layer),
-      program_("fullscreen.vert", "road_composite.frag"),
-      u_min_depth_(program_.uniform("u_min_depth")),
+      program_("road_composite.vert", "road_composite.frag"),
+      u_depth_clip_(program_.uniform("u_depth_clip")),
       u_inv_viewport_(program_.uniform("u_inv_viewport")) {}
 
 void RoadCompositePass::execute(const FrameContext& frame, const FrameResources& r) {
-  // The rows and columns where the layer may hold road, a layer's texel wider each way (its
-  // bilinear neighbours).
-  const glm::vec4 b = layer_.screen_bounds();
-  if (b.z < b.x || b.w < b.y) return;
-  const glm::vec2 size(r.view_colour.width, r.view_colour.height);
-  const glm::ivec2 lo =
-      glm::max(glm::ivec2(glm::floor((glm::vec2(b) * 0.5f + 0.5f) * size)) - kRoadLayerScale, 0);
-  const glm::ivec2 hi =
-      glm::min(glm::ivec2(glm::ceil((glm::vec2(b.z, b.w) * 0.5f + 0.5f) * size)) + kRoadLayerScale,
-               glm::ivec2(size));
-  if (hi.x <= lo.x || hi.y <= lo.y) return;
-  glEnable(GL_SCISSOR_TEST);
-  glScissor(lo.x, lo.y, hi.x - lo.x, hi.y - lo.y);
   program_.use();
-  // Up to the split, and a hundredth beyond it, under the far part (road_far): no pixel between.
-  u_min_depth_.set(reversed_z(frame.camera.near_m, 1.01f * RoadPass::layer_split_m(frame)));
-  u_inv_viewport_.set(1.0f / size);
-  shared_.fullscreen.draw();
-  glDisable(GL_SCISSOR_TEST);
+  // The near part's triangles at its levels (the surface the layer holds), up to the split and a
+  // hundredth beyond it, under the far part (road_far): no pixel between.
+  const glm::mat4& v = frame.camera.view;
+  const glm::vec3 n = -glm::vec3(v[0][2], v[1][2], v[2][2]);
+  const float end = 1.01f * RoadPass::layer_split_m(frame);
+  u_depth_clip_.set(glm::vec4(-n, end - (-v[3][2])));
+  u_inv_viewport_.set(1.0f / glm::vec2(r.view_colour.width, r.view_colour.height));
+  const RoadPass::NearDraw& d = layer_.near_draw();
+  frame.world->road.draw_visible(frame.camera.projection * frame.camera.view, frame.camera.position,
+                                 d.detail, 0.0f, d.to_m);
 }
 
 }  // namespace downpour::render
