@@ -1,10 +1,12 @@
 // The road's meshes built from an OpenDRIVE network: lane sections whose lanes differ in number
-// give each its own mesh, whole and indexed within its vertices; a narrow one-sided road's relief
-// is made without a bowl out of its room. The terrain's chunks meet without a crack where two are
-// drawn at one level, so that their skirts are needed only where the levels differ.
+// give each its own mesh, whole and indexed within its vertices; the coarser levels' verges reach
+// as far and as low on fewer stations; a narrow one-sided road's relief is made without a bowl out
+// of its room. The terrain's chunks meet without a crack where two are drawn at one level, so that
+// their skirts are needed only where the levels differ.
 #include "server/render/cpu/scene_geometry.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <tuple>
@@ -79,6 +81,36 @@ TEST(SceneGeometryTest, LaneSectionsOfDifferentLanesMakeWholeMeshes) {
       const double r = surface.relief({1, s, t});
       ASSERT_LE(r, 0.0);
       ASSERT_GT(r, -0.05);
+    }
+  }
+}
+
+TEST(SceneGeometryTest, TheCoarserLevelsVergesReachAsFarOnFewerStations) {
+  const auto roads = std::make_shared<const sim::OpenDriveRoads>(road::parse_opendrive(network()));
+  for (const std::vector<MeshData>& levels : build_road_chunks(*roads)) {
+    // Each level's columns (lateral offsets: stations and lane borders) and its lowest point.
+    auto columns = [](const MeshData& m) {
+      std::vector<float> t;
+      for (const MeshVertex& v : m.vertices) t.push_back(v.uv.x);
+      std::sort(t.begin(), t.end());
+      t.erase(
+          std::unique(t.begin(), t.end(), [](float a, float b) { return std::abs(a - b) < 1e-4f; }),
+          t.end());
+      return t;
+    };
+    auto lowest = [](const MeshData& m) {
+      float z = 1e30f;
+      for (const MeshVertex& v : m.vertices) z = std::min(z, v.position.z);
+      return z;
+    };
+    const std::vector<float> fine = columns(levels[0]);
+    for (std::size_t l = 1; l < levels.size(); ++l) {
+      const std::vector<float> coarse = columns(levels[l]);
+      // Two stations fewer on each verge (its edge, then every 2 m, not every metre).
+      EXPECT_EQ(coarse.size() + 4, fine.size()) << "level " << l;
+      EXPECT_NEAR(coarse.front(), fine.front(), 1e-4f);
+      EXPECT_NEAR(coarse.back(), fine.back(), 1e-4f);
+      EXPECT_NEAR(lowest(levels[l]), lowest(levels[0]), 1e-3f);
     }
   }
 }
