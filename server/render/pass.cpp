@@ -87,14 +87,12 @@ constexpr ResourceInfo kResources[] = {
      .name = "client image",
      .texture_unit = texture_unit::kClientImage,
      .from_frame = true},
-    // Alpha 0 and the far plane (0, reversed-Z) where no road is; its depth at its own unit
-    // (kRoadLayerDepth).
+    // Alpha 0 where no road is; a depth of its own, for the layer's own draws.
     {.resource = R::kRoadLayer,
      .name = "road layer",
      .texture_unit = texture_unit::kRoadLayer,
      .scale = kRoadLayerScale,
-     .depth_from = R::kRoadLayer,
-     .linear_depth = true},
+     .depth_from = R::kRoadLayer},
 };
 static_assert(std::size(kResources) == kResourceCount);
 constexpr bool in_order() {

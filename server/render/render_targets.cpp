@@ -116,9 +116,8 @@ Transient& TransientTargets::get(Resource r, int width, int height, std::uint64_
     t.depth = make_texture_2d(GL_DEPTH_COMPONENT32F, width, height);
     glTextureParameteri(t.depth.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTextureParameteri(t.depth.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    const GLint depth_filter = info.linear_depth ? GL_LINEAR : GL_NEAREST;
-    glTextureParameteri(t.depth.id(), GL_TEXTURE_MIN_FILTER, depth_filter);
-    glTextureParameteri(t.depth.id(), GL_TEXTURE_MAG_FILTER, depth_filter);
+    glTextureParameteri(t.depth.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(t.depth.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   }
   // (A borrowed depth is attached as the frame binds it: its owner may be made again.)
   t.fbo = framebuffer_with(t.texture.id(), t.depth.id());

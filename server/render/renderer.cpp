@@ -209,6 +209,7 @@ struct Renderer::Impl {
         texture = r.view_depth.texture;
         break;
       case Resource::kGlassLayer:
+      case Resource::kRoadLayer:
       case Resource::kSprayLayer:
       case Resource::kSprayMaps:
       case Resource::kSprayBodyFront:
@@ -218,10 +219,6 @@ struct Renderer::Impl {
       case Resource::kRoadReflection:
         texture = r.transient(res).colour.texture;
         glBindTextureUnit(texture_unit::kReflectionDepth, r.transient(res).depth.texture);
-        break;
-      case Resource::kRoadLayer:
-        texture = r.transient(res).colour.texture;
-        glBindTextureUnit(texture_unit::kRoadLayerDepth, r.transient(res).depth.texture);
         break;
       case Resource::kGlassSurface:
         session.upload_glass_surface(f.water().surface);

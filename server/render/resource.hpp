@@ -75,7 +75,6 @@ struct ResourceInfo {
   // The depth attached to a transient's framebuffer: its own (this resource), another
   // transient's of the same size (the spray's mask, for the tests against it), or none.
   std::optional<Resource> depth_from = std::nullopt;
-  bool linear_depth = false;  // its own depth read with bilinear filtering, else the nearest
   // What a transient holds before the first pass of a frame draws into it (its own depth too).
   std::array<float, 4> clear_colour = {0.0f, 0.0f, 0.0f, 0.0f};
   float clear_depth = 0.0f;

@@ -70,8 +70,7 @@ namespace downpour::render {
   X(kModelTexture, 26, sampler2DArray, model_tex,                                                  \
     "the model being drawn's base-colour textures, a layer each (sRGB, mipmapped)")                \
   X(kRoadLayer, 27, sampler2D, road_layer_tex,                                                     \
-    "the road at half the view's size (display-encoded), alpha 1 where drawn (road_pass.hpp)")     \
-  X(kRoadLayerDepth, 28, sampler2D, road_layer_depth_tex, "its depth (reversed-Z)")
+    "the road at half the view's size (display-encoded), alpha 1 where drawn (road_pass.hpp)")
 
 // The per-frame uniform block: X(GLSL type, name, comment). Every field is a vec4 or a mat4, so
 // the C++ struct below has the std140 layout as it is.
