@@ -63,6 +63,15 @@ RoadPass::RoadPass(SharedResources& shared, RoadPart part)
 
 namespace {
 
+// The plane (xyz . p + w at least 0 is kept: gl_ClipDistance[2]) that keeps what lies nearer than
+// depth_m on the view's depth, d(p) = n . p + w0 (the view looks down its -z), or, `beyond`, what
+// lies further.
+glm::vec4 depth_plane(const glm::mat4& view, float depth_m, bool beyond) {
+  const glm::vec3 n = -glm::vec3(view[0][2], view[1][2], view[2][2]);
+  const float w0 = -view[3][2];
+  return beyond ? glm::vec4(n, w0 - depth_m) : glm::vec4(-n, depth_m - w0);
+}
+
 // The pixel angle of a view's rows (rad).
 float pixel_rad(const FrameContext& frame) {
   return 2.0f * std::tan(glm::radians(frame.camera.fov_y_deg) * 0.5f) /
@@ -122,16 +131,13 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
   const float detail =
       frame.detail_distance_scale * (part_ == RoadPart::kWhole ? 1.0f : kPartsDetailScale);
   // This part's range of the chunks' distances (m from the camera), and its plane on the view's
-  // depth, d(p) = n . p + w0 (the view looks down its -z).
-  const glm::mat4& v = frame.camera.view;
-  const glm::vec3 n = -glm::vec3(v[0][2], v[1][2], v[2][2]);
-  const float w0 = -v[3][2];
+  // depth.
   const float split = layer_split_m(frame);
   float from_m = 0.0f, to_m = 1e30f;
   glm::vec4 depth_clip(0.0f, 0.0f, 0.0f, 1.0f);
   if (part_ == RoadPart::kNearInLayer) {
     const float end = split + kLayerOverlapM;
-    depth_clip = glm::vec4(-n, end - w0);
+    depth_clip = depth_plane(frame.camera.view, end, false);
     // A point at depth `end` lies this far at the view's corners.
     const float tan_y = std::tan(glm::radians(frame.camera.fov_y_deg) * 0.5f);
     const float tan_x = tan_y * static_cast<float>(frame.spec.width) /
@@ -139,7 +145,7 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
     to_m = end * std::sqrt(1.0f + tan_x * tan_x + tan_y * tan_y);
     near_draw_ = {detail, to_m};
   } else if (part_ == RoadPart::kFar) {
-    depth_clip = glm::vec4(n, w0 - split);
+    depth_clip = depth_plane(frame.camera.view, split, true);
     from_m = split;
   }
   // Relief shadows: the near road with them, the rest without (llvmpipe would fetch the horizon
@@ -187,10 +193,7 @@ void RoadCompositePass::execute(const FrameContext& frame, const FrameResources&
   program_.use();
   // The near part's triangles at its levels (the surface the layer holds), up to the split and a
   // hundredth beyond it, under the far part (road_far): no pixel between.
-  const glm::mat4& v = frame.camera.view;
-  const glm::vec3 n = -glm::vec3(v[0][2], v[1][2], v[2][2]);
-  const float end = 1.01f * RoadPass::layer_split_m(frame);
-  u_depth_clip_.set(glm::vec4(-n, end - (-v[3][2])));
+  u_depth_clip_.set(depth_plane(frame.camera.view, 1.01f * RoadPass::layer_split_m(frame), false));
   u_inv_viewport_.set(1.0f / glm::vec2(r.view_colour.width, r.view_colour.height));
   const RoadPass::NearDraw& d = layer_.near_draw();
   frame.world->road.draw_visible(frame.camera.projection * frame.camera.view, frame.camera.position,
