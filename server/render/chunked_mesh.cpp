@@ -124,7 +124,8 @@ void ChunkedMesh::build(const std::vector<std::vector<MeshData>>& chunks,
 }
 
 int ChunkedMesh::level_for(const Chunk& chunk, const glm::mat4& view_proj, const glm::vec3& camera,
-                           float distance_scale, float from_m, float to_m) const {
+                           float distance_scale, float from_m, float to_m,
+                           float level_from_m) const {
   if (chunk.levels.empty() || !box_visible(view_proj, chunk.bounds_min, chunk.bounds_max))
     return -1;
   const float nearest =
@@ -133,11 +134,10 @@ int ChunkedMesh::level_for(const Chunk& chunk, const glm::mat4& view_proj, const
   if (from_m > 0.0f && glm::length(glm::max(glm::abs(camera - chunk.bounds_min),
                                             glm::abs(camera - chunk.bounds_max))) < from_m)
     return -1;
-  // (Of the part drawn: a chunk that reaches under the camera but is drawn only from `from_m` on,
-  // as the road's far part, takes the level of its nearest drawn point. Each triangle costs
-  // llvmpipe about 0.4 us however little of it is drawn: the chunk under a 640x360 ROAD camera,
-  // drawn from 17 m at its finest level, was 1,540 of the far road's 3,920 triangles.)
-  const float distance = std::max(nearest, from_m) * distance_scale;
+  // (llvmpipe sets up every triangle that reaches the view, however little of it is drawn: the
+  // chunk under a 640x360 ROAD camera, drawn from 17 m at its finest level, was 1,540 of the far
+  // road's 3,920 triangles.)
+  const float distance = std::max(nearest, level_from_m) * distance_scale;
   if (distance >= max_distance_m_) return -1;
   std::size_t level = 0;
   while (level < level_distances_m_.size() && level + 1 < chunk.levels.size() &&
@@ -149,10 +149,13 @@ int ChunkedMesh::level_for(const Chunk& chunk, const glm::mat4& view_proj, const
 
 template <typename Fn>
 void ChunkedMesh::for_each_drawn(const glm::mat4& view_proj, const glm::vec3& camera,
-                                 float distance_scale, float from_m, float to_m, Fn&& fn) const {
+                                 float distance_scale, float from_m, float to_m, float level_from_m,
+                                 Fn&& fn) const {
   // Each chunk's level, or -1 where it is not drawn.
-  for (std::size_t c = 0; c < chunks_.size(); ++c)
-    level_drawn_[c] = level_for(chunks_[c], view_proj, camera, distance_scale, from_m, to_m);
+  for (std::size_t c = 0; c < chunks_.size(); ++c) {
+    level_drawn_[c] =
+        level_for(chunks_[c], view_proj, camera, distance_scale, from_m, to_m, level_from_m);
+  }
   for (std::size_t c = 0; c < chunks_.size(); ++c) {
     const int level = level_drawn_[c];
     if (level < 0) continue;
@@ -167,11 +170,13 @@ void ChunkedMesh::for_each_drawn(const glm::mat4& view_proj, const glm::vec3& ca
 }
 
 void ChunkedMesh::draw_visible(const glm::mat4& view_proj, const glm::vec3& camera,
-                               float distance_scale, float from_m, float to_m) const {
+                               float distance_scale, float from_m, float to_m,
+                               float level_from_m) const {
   ranges_.clear();
-  for_each_drawn(view_proj, camera, distance_scale, from_m, to_m, [this](const Range& r) {
-    if (r.count != 0) ranges_.push_back(r);
-  });
+  for_each_drawn(view_proj, camera, distance_scale, from_m, to_m, level_from_m,
+                 [this](const Range& r) {
+                   if (r.count != 0) ranges_.push_back(r);
+                 });
   // Ranges that meet in the buffer become one.
   std::sort(ranges_.begin(), ranges_.end(),
             [](const Range& a, const Range& b) { return a.first_index < b.first_index; });
@@ -192,9 +197,10 @@ void ChunkedMesh::draw_visible(const glm::mat4& view_proj, const glm::vec3& came
 }
 
 std::size_t ChunkedMesh::visible_triangles(const glm::mat4& view_proj, const glm::vec3& camera,
-                                           float distance_scale, float from_m, float to_m) const {
+                                           float distance_scale, float from_m, float to_m,
+                                           float level_from_m) const {
   std::size_t triangles = 0;
-  for_each_drawn(view_proj, camera, distance_scale, from_m, to_m,
+  for_each_drawn(view_proj, camera, distance_scale, from_m, to_m, level_from_m,
                  [&](const Range& r) { triangles += r.count / 3; });
   return triangles;
 }

@@ -13,7 +13,6 @@
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
-#include <glm/vec4.hpp>
 
 #include "server/model/mesh_data.hpp"
 #include "server/render/gl/gl_objects.hpp"
@@ -22,8 +21,9 @@ namespace downpour::render {
 
 class ChunkedMesh {
  public:
-  // chunks[c][level]: level 0 the finest. A chunk is drawn at level k when its nearest point is
-  // at least level_distances_m[k - 1] from the camera, and not at all from max_distance_m on.
+  // chunks[c][level]: level 0 the finest. A chunk is drawn at level k when its nearest point (or
+  // draw_visible's level_from_m, where that is further) times the distance scale is at least
+  // level_distances_m[k - 1] from the camera, and not at all from max_distance_m on.
   ChunkedMesh() = default;
   ChunkedMesh(const std::vector<std::vector<MeshData>>& chunks,
               std::vector<float> level_distances_m, float max_distance_m = 1e30f);
@@ -34,15 +34,20 @@ class ChunkedMesh {
   ChunkedMesh(const SkirtedChunks& chunks, std::vector<float> level_distances_m,
               float max_distance_m = 1e30f);
   // Draws the chunks whose bounds meet the view's frustum, and reach from `from_m` to `to_m` of the
-  // camera, with the bound program, each at the level for its distance (from_m where its nearest
-  // point is nearer) times distance_scale, in one call. A chunk outside [from_m, to_m) counts as
-  // not drawn for its neighbours' skirts.
+  // camera, with the bound program, each at the level for its distance times distance_scale, in
+  // one call. A chunk outside [from_m, to_m) counts as not drawn for its neighbours' skirts.
+  // level_from_m: where a chunk's nearest point is nearer, its level is that distance's. A part of
+  // the mesh drawn only from some distance on (the road's far part) gives it, so that the chunk
+  // under the camera is not drawn at its finest level for what lies beyond; draws that must meet
+  // the same surface (the road's relief and plain draws of one part, its layer and composite)
+  // give the same.
   void draw_visible(const glm::mat4& view_proj, const glm::vec3& camera,
-                    float distance_scale = 1.0f, float from_m = 0.0f, float to_m = 1e30f) const;
+                    float distance_scale = 1.0f, float from_m = 0.0f, float to_m = 1e30f,
+                    float level_from_m = 0.0f) const;
   // The triangles draw_visible() would draw (for tests and benchmarks).
   std::size_t visible_triangles(const glm::mat4& view_proj, const glm::vec3& camera,
                                 float distance_scale = 1.0f, float from_m = 0.0f,
-                                float to_m = 1e30f) const;
+                                float to_m = 1e30f, float level_from_m = 0.0f) const;
 
  private:
   struct Range {
@@ -53,12 +58,12 @@ class ChunkedMesh {
   struct Chunk;
   // The level a chunk is drawn at, as draw_visible() says, or -1.
   int level_for(const Chunk& chunk, const glm::mat4& view_proj, const glm::vec3& camera,
-                float distance_scale, float from_m, float to_m) const;
+                float distance_scale, float from_m, float to_m, float level_from_m) const;
   // Calls fn with each range of indices to draw: the visible chunks' surfaces at their levels,
   // and the skirts between two of them drawn at different levels.
   template <typename Fn>
   void for_each_drawn(const glm::mat4& view_proj, const glm::vec3& camera, float distance_scale,
-                      float from_m, float to_m, Fn&& fn) const;
+                      float from_m, float to_m, float level_from_m, Fn&& fn) const;
 
   struct Chunk {
     std::vector<Range> levels;

@@ -12,9 +12,9 @@ World make_world(const WorldGeometry& g) {
   w.street_lights = g.street_lights;
   // The road's rows every 8 m from 120 m (at the scale of COCKPIT's 720 rows): where a 300 m
   // curve's 8 m chords, 3 cm off the arc, are a fifth of a pixel. The road's far part in a chase
-  // view (road_pass.hpp), which starts at the same depth at every size, four times nearer, at
-  // 125: so the chunk under its camera is drawn there with 8 m rows, not 2 m (1,540 of that
-  // part's 3,920 triangles in a 640x360 ROAD).
+  // view (road_pass.hpp) starts where a layer's texel spans 10 cm: at its four times nearer
+  // levels that is 125 at every size (17.3 m at 640x360), so the chunk under its camera is drawn
+  // there with 8 m rows (ChunkedMesh::draw_visible's level_from_m).
   w.road = ChunkedMesh(g.road, {120.0f, 500.0f});
   w.terrain = ChunkedMesh(g.terrain, {200.0f, 500.0f, 1200.0f});
   w.street_light_poles = ChunkedMesh(g.poles, {}, kStreetLightsDrawnWithin_m);

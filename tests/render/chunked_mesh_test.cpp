@@ -44,11 +44,14 @@ TEST_F(ChunkedMeshTest, AChunkDrawnFromADistanceTakesTheLevelOfThatDistance) {
   }
   const ChunkedMesh mesh({{fine, ground(-5.0f, 60.0f, -4.0f, 4.0f)}}, {20.0f});
   EXPECT_EQ(mesh.visible_triangles(view_proj, camera), 32u);  // (its nearest point under it)
-  EXPECT_EQ(mesh.visible_triangles(view_proj, camera, 1.0f, 10.0f), 32u);
-  // From 30 m on, only its part beyond 30 m is drawn: the coarse level.
-  EXPECT_EQ(mesh.visible_triangles(view_proj, camera, 1.0f, 30.0f), 2u);
+  EXPECT_EQ(mesh.visible_triangles(view_proj, camera, 1.0f, 10.0f, 1e30f, 10.0f), 32u);
+  // Drawn from 30 m on with its levels from there: the coarse level.
+  EXPECT_EQ(mesh.visible_triangles(view_proj, camera, 1.0f, 30.0f, 1e30f, 30.0f), 2u);
   // And from 10 m at twice the distances.
-  EXPECT_EQ(mesh.visible_triangles(view_proj, camera, 2.0f, 10.0f), 2u);
+  EXPECT_EQ(mesh.visible_triangles(view_proj, camera, 2.0f, 10.0f, 1e30f, 10.0f), 2u);
+  // Drawn from 30 m on with its levels from the camera (a draw that must meet one from the
+  // camera on the same surface): the fine level.
+  EXPECT_EQ(mesh.visible_triangles(view_proj, camera, 1.0f, 30.0f), 32u);
 }
 
 }  // namespace

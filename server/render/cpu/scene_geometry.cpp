@@ -57,12 +57,12 @@ double cross_slope(const sim::RoadNetwork& roads, int road, double s, double t,
 void road_piece(const sim::RoadNetwork& roads, int road, double s0, double s1,
                 double chunk_length_m, double step_m, std::vector<MeshData>& chunks) {
   // The verge's stations: the edge, then every metre; every 2 m at the coarser levels, further
-  // off. (Each triangle costs llvmpipe about 0.4 us however small: the far part of a 640x360 ROAD
+  // off, where fewer triangles are cheaper (chunked_mesh.hpp): the far part of a 640x360 ROAD
   // view's road took 0.62 of the terrain's time, in turn, against 0.69; its picture the same to
   // within 10 levels in a pixel. Where levels meet, the middle stations stand 2 cm off the coarser
   // level's chord: under half a pixel at the nearest such seam, the split of a 640x360 ROAD's
-  // road at 17 m.)
-  const int kVergeStations = step_m > kRoadStepsM[0] ? 3 : 5;
+  // road at 17 m.
+  const int verge_stations = step_m > kRoadStepsM[0] ? 3 : 5;
   for (double c0 = s0; c0 < s1 - 1e-6; c0 += chunk_length_m) {
     const double c1 = std::min(c0 + chunk_length_m, s1);
     std::vector<double> rows;
@@ -98,9 +98,9 @@ void road_piece(const sim::RoadNetwork& roads, int road, double s0, double s1,
         const sim::RoadPlace other = roads.project(beyond, 30.0);
         const bool covered =
             other.road != road && roads.paved(other.road, other.s).contains(other.t);
-        for (int k = 1; k < kVergeStations; ++k) {
-          const int station = covered ? 0 : way > 0.0 ? k : kVergeStations - k;
-          const double u = station * (kVerge / (kVergeStations - 1)) / kVerge;
+        for (int k = 1; k < verge_stations; ++k) {
+          const int station = covered ? 0 : way > 0.0 ? k : verge_stations - k;
+          const double u = station * (kVerge / (verge_stations - 1)) / kVerge;
           const double slope = -way * 2.0 * kVergeDrop * u / kVerge;
           vertex(edge + way * u * kVerge, z - kVergeDrop * u * u, slope,
                  VertexLane{static_cast<float>(edge), static_cast<float>(way) * kVergeStrip, 0.0f,

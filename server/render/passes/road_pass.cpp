@@ -125,9 +125,11 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
   // (The far part's triangles are small, and llvmpipe shades whole blocks of pixels around each:
   // the far part at the coarser levels from a quarter of their distances took 0.84-0.86 of the
   // time in turn with the view's own, in a 640x360 ROAD. The near part takes the same scale. The
-  // chunk that reaches across the split may be finer in the near part, which goes on from its
-  // camera, than in the far one (ChunkedMesh::draw_visible): on a curve their edges then meet a
-  // chord's sag apart, 3 cm where 8 m rows bend around 300 m, under a pixel at the split.)
+  // chunk that reaches across the split is finer in the near part, which goes on from its camera,
+  // than in the far one, which takes its levels from the split (ChunkedMesh::draw_visible): on a
+  // curve their edges meet a chord's sag apart at the split, 3 cm where 8 m rows bend around
+  // 300 m, under a pixel; on a junction's tight turn (20 m) 40 cm, as the far part's chunks
+  // beyond 21 m already were.)
   const float detail =
       frame.detail_distance_scale * (part_ == RoadPart::kWhole ? 1.0f : kPartsDetailScale);
   // This part's range of the chunks' distances (m from the camera), and its plane on the view's
@@ -168,15 +170,16 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
     depth_clip_[plain + 3].set(depth_clip);
     // (Only the chunks that reach into the near part, and then those that reach beyond it.)
     frame.world->road.draw_visible(view_proj, frame.camera.position, detail, from_m,
-                                   std::min(reach, to_m));
+                                   std::min(reach, to_m), from_m);
   }
   if (relief_here && reach >= to_m) return;  // (the relief's draw held all of this part)
   programs_[plain].use();
   mean_lit_[plain].set(mean_lit);
   near_split_[plain].set(glm::vec2(relief_here ? reach : 0.0f, -1.0f));
   depth_clip_[plain].set(depth_clip);
+  // (The part's levels from its own start, as the relief's draw: both meet the same surface.)
   frame.world->road.draw_visible(view_proj, frame.camera.position, detail,
-                                 relief_here ? std::max(reach, from_m) : from_m, to_m);
+                                 relief_here ? std::max(reach, from_m) : from_m, to_m, from_m);
 }
 
 RoadCompositePass::RoadCompositePass(const RoadPass& layer)
@@ -192,8 +195,11 @@ RoadCompositePass::RoadCompositePass(const RoadPass& layer)
 void RoadCompositePass::execute(const FrameContext& frame, const FrameResources& r) {
   program_.use();
   // The near part's triangles at its levels (the surface the layer holds), up to the split and a
-  // hundredth beyond it, under the far part (road_far): no pixel between.
-  u_depth_clip_.set(depth_plane(frame.camera.view, 1.01f * RoadPass::layer_split_m(frame), false));
+  // hundredth beyond it, under the far part (road_far): no pixel between. (Never past the layer's
+  // own end, kLayerOverlapM beyond the split, where a far split of a narrow view lies 200 m out.)
+  const float split = RoadPass::layer_split_m(frame);
+  u_depth_clip_.set(depth_plane(
+      frame.camera.view, split + std::min(0.01f * split, 0.5f * RoadPass::kLayerOverlapM), false));
   u_inv_viewport_.set(1.0f / glm::vec2(r.view_colour.width, r.view_colour.height));
   const RoadPass::NearDraw& d = layer_.near_draw();
   frame.world->road.draw_visible(frame.camera.projection * frame.camera.view, frame.camera.position,

@@ -5,8 +5,6 @@
 #include <memory>
 #include <vector>
 
-#include <glm/vec4.hpp>
-
 #include "server/render/chunked_mesh.hpp"
 #include "server/render/pass.hpp"
 

@@ -87,7 +87,9 @@ TEST(SceneGeometryTest, LaneSectionsOfDifferentLanesMakeWholeMeshes) {
 
 TEST(SceneGeometryTest, TheCoarserLevelsVergesReachAsFarOnFewerStations) {
   const auto roads = std::make_shared<const sim::OpenDriveRoads>(road::parse_opendrive(network()));
-  for (const std::vector<MeshData>& levels : build_road_chunks(*roads)) {
+  const std::vector<std::vector<MeshData>> chunks = build_road_chunks(*roads);
+  ASSERT_FALSE(chunks.empty());
+  for (const std::vector<MeshData>& levels : chunks) {
     // Each level's columns (lateral offsets: stations and lane borders) and its lowest point.
     auto columns = [](const MeshData& m) {
       std::vector<float> t;
@@ -106,7 +108,9 @@ TEST(SceneGeometryTest, TheCoarserLevelsVergesReachAsFarOnFewerStations) {
     const std::vector<float> fine = columns(levels[0]);
     for (std::size_t l = 1; l < levels.size(); ++l) {
       const std::vector<float> coarse = columns(levels[l]);
-      // Two stations fewer on each verge (its edge, then every 2 m, not every metre).
+      // Two stations fewer on each verge (its edge, then every 2 m, not every metre). (This
+      // network's verges are all open, no other road's pavement beyond them, and its lanes keep
+      // their widths: each lateral offset a column.)
       EXPECT_EQ(coarse.size() + 4, fine.size()) << "level " << l;
       EXPECT_NEAR(coarse.front(), fine.front(), 1e-4f);
       EXPECT_NEAR(coarse.back(), fine.back(), 1e-4f);
