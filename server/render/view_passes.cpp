@@ -44,8 +44,7 @@ ViewPasses make_view_passes(SharedResources& shared, FrameBlockBuffer& block,
   if (road_at_half) {
     p.road_layer = own(std::make_unique<RoadPass>(shared, RoadPart::kNearInLayer));
     p.road_far = own(std::make_unique<RoadPass>(shared, RoadPart::kFar));
-    chase_road = {p.road_layer, own(std::make_unique<RoadCompositePass>(*p.road_layer)),
-                  p.road_far};
+    chase_road = {p.road_layer, own(std::make_unique<RoadCompositePass>()), p.road_far};
   }
   Pass* terrain = own(std::make_unique<TerrainPass>(shared));
   Pass* sky = own(std::make_unique<SkyPass>(shared));

@@ -92,6 +92,15 @@ float RoadPass::relief_reach_m(const FrameContext& frame, int scale) {
   return 1.1f * std::sqrt(kSettsResolvedToM * height / pixel);
 }
 
+float RoadPass::near_reach_m(const FrameContext& frame) {
+  // A point at the near part's end on the view's depth lies this far at the view's corners.
+  const float end = layer_split_m(frame) + kLayerOverlapM;
+  const float tan_y = std::tan(glm::radians(frame.camera.fov_y_deg) * 0.5f);
+  const float tan_x = tan_y * static_cast<float>(frame.spec.width) /
+                      static_cast<float>(std::max(frame.spec.height, 1));
+  return end * std::sqrt(1.0f + tan_x * tan_x + tan_y * tan_y);
+}
+
 float RoadPass::layer_split_m(const FrameContext& frame) {
   return kLayerTexelM / (static_cast<float>(kRoadLayerScale) * pixel_rad(frame));
 }
@@ -138,14 +147,8 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
   float from_m = 0.0f, to_m = 1e30f;
   glm::vec4 depth_clip(0.0f, 0.0f, 0.0f, 1.0f);
   if (part_ == RoadPart::kNearInLayer) {
-    const float end = split + kLayerOverlapM;
-    depth_clip = depth_plane(frame.camera.view, end, false);
-    // A point at depth `end` lies this far at the view's corners.
-    const float tan_y = std::tan(glm::radians(frame.camera.fov_y_deg) * 0.5f);
-    const float tan_x = tan_y * static_cast<float>(frame.spec.width) /
-                        static_cast<float>(std::max(frame.spec.height, 1));
-    to_m = end * std::sqrt(1.0f + tan_x * tan_x + tan_y * tan_y);
-    near_draw_ = {detail, to_m};
+    depth_clip = depth_plane(frame.camera.view, split + kLayerOverlapM, false);
+    to_m = near_reach_m(frame);
   } else if (part_ == RoadPart::kFar) {
     depth_clip = depth_plane(frame.camera.view, split, true);
     from_m = split;
@@ -182,12 +185,11 @@ void RoadPass::execute(const FrameContext& frame, const FrameResources& resource
                                  relief_here ? std::max(reach, from_m) : from_m, to_m, from_m);
 }
 
-RoadCompositePass::RoadCompositePass(const RoadPass& layer)
+RoadCompositePass::RoadCompositePass()
     : decl_{std::string(kRoadPassNames[2]),
             {Resource::kRoadLayer},
             {Resource::kViewColour, Resource::kViewDepth},
             {DepthTest::kNearer, true, Blend::kOff, true, false, 0b100}},
-      layer_(layer),
       program_("road_composite.vert", "road_composite.frag"),
       u_depth_clip_(program_.uniform("u_depth_clip")),
       u_inv_viewport_(program_.uniform("u_inv_viewport")) {}
@@ -201,9 +203,9 @@ void RoadCompositePass::execute(const FrameContext& frame, const FrameResources&
   u_depth_clip_.set(depth_plane(
       frame.camera.view, split + std::min(0.01f * split, 0.5f * RoadPass::kLayerOverlapM), false));
   u_inv_viewport_.set(1.0f / glm::vec2(r.view_colour.width, r.view_colour.height));
-  const RoadPass::NearDraw& d = layer_.near_draw();
   frame.world->road.draw_visible(frame.camera.projection * frame.camera.view, frame.camera.position,
-                                 d.detail, 0.0f, d.to_m);
+                                 frame.detail_distance_scale * RoadPass::kPartsDetailScale, 0.0f,
+                                 RoadPass::near_reach_m(frame));
 }
 
 }  // namespace downpour::render

@@ -31,6 +31,9 @@ class RoadPass final : public Pass {
   explicit RoadPass(SharedResources& shared, RoadPart part = RoadPart::kWhole);
   // Where the near part ends: the view's depth (m) at which a layer's texel spans kLayerTexelM.
   static float layer_split_m(const FrameContext& frame);
+  // How far from the camera the near part's chunks reach (m): to its end on the view's depth,
+  // kLayerOverlapM beyond the split, at the view's corners. The composite draws the same.
+  static float near_reach_m(const FrameContext& frame);
   static constexpr float kLayerTexelM = 0.1f;
   // The near part reaches this much further, for the composite's bilinear texels at its end.
   static constexpr float kLayerOverlapM = 2.0f;
@@ -44,13 +47,6 @@ class RoadPass final : public Pass {
   bool relief_shadows() const { return relief_; }
   // Whether the last frame drew them.
   bool drew_relief() const { return drew_relief_; }
-  // The near part's chunks as this frame's layer drew them (kNearInLayer), for the composite's
-  // triangles: their levels' distance scale and how far from the camera they reach.
-  struct NearDraw {
-    float detail = 1.0f;
-    float to_m = 0.0f;
-  };
-  const NearDraw& near_draw() const { return near_draw_; }
   // How far from the camera a pixel can still resolve the relief's shadows (m), for pixels
   // `scale` times the view's each way.
   static float relief_reach_m(const FrameContext& frame, int scale = 1);
@@ -74,7 +70,6 @@ class RoadPass final : public Pass {
   std::shared_ptr<const relief::RoadReliefs> reliefs_;
   bool relief_ = true;
   bool drew_relief_ = false;
-  NearDraw near_draw_;
 };
 
 // The road's layer (RoadPass's near part) brought into the view, on the near road's own
@@ -86,13 +81,12 @@ class RoadPass final : public Pass {
 // is shaded before the depth test, on every pixel of the rectangle it covers.
 class RoadCompositePass final : public Pass {
  public:
-  explicit RoadCompositePass(const RoadPass& layer);
+  RoadCompositePass();
   const PassDecl& decl() const override { return decl_; }
   void execute(const FrameContext& frame, const FrameResources& resources) override;
 
  private:
   const PassDecl decl_;
-  const RoadPass& layer_;
   ShaderProgram program_;
   Uniform u_depth_clip_, u_inv_viewport_;
 };
