@@ -1,7 +1,8 @@
-// The rain layer alone (rain_layer.hpp): the CPU's streaks for the COCKPIT view of the standard
-// scene, without GL, so that its cost can be measured quietly and compared change by change.
+// The rain layer alone (rain_layer.hpp): the CPU's streaks for the COCKPIT view (or ROAD's chase
+// camera) of the standard scene, without GL, so that its cost can be measured quietly and compared
+// change by change.
 //   downpour-rain-layer-bench [--counts N ...] [--frames F] [--size WxH] [--no-splashes]
-//                             [--warm-seconds S]
+//                             [--warm-seconds S] [--view cockpit|road]
 // For each rain_streak_count, the scene's drive is warmed for S s (2 by default) and the layer is
 // built for F frames (the simulation stepping between them); prints one JSON line per count: the
 // streaks drawn and the splashes alive (medians), and the layer's median and 90th-percentile
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
   std::string size = "640x360";
   bool splashes_too = true;
   double warm_s = 2.0;
+  std::string view_name = "cockpit";
   CLI::App app{"Downpour rain layer benchmark: the CPU streaks of one view, as JSON lines"};
   app.add_option("--counts", counts, "rain_streak_count values");
   app.add_option("--frames", frames)->check(CLI::Range(5, 100000));
@@ -42,13 +44,16 @@ int main(int argc, char** argv) {
   app.add_flag("!--no-splashes", splashes_too, "the streaks alone");
   app.add_option("--warm-seconds", warm_s, "the scene's drive before measuring")
       ->check(CLI::Range(0.0, 600.0));
+  app.add_option("--view", view_name, "the view: cockpit, or road (the chase camera)")
+      ->check(CLI::IsMember({"cockpit", "road"}));
   CLI11_PARSE(app, argc, argv);
+  const sim::View view = view_name == "road" ? sim::View::kRoad : sim::View::kCockpit;
   int width = 0, height = 0;
   if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16) {
     std::fprintf(stderr, "--size: WIDTHxHEIGHT\n");
     return 2;
   }
-  const sim::ViewSpec spec = sim::view_spec(sim::View::kCockpit, width, height);
+  const sim::ViewSpec spec = sim::view_spec(view, width, height);
   const int layer_w =
       (width + render::RainPass::kLayerDivisor - 1) / render::RainPass::kLayerDivisor;
   const int layer_h =
@@ -86,7 +91,7 @@ int main(int argc, char** argv) {
                                        [&]() -> const sim::SceneState& { return state; }};
       render::RainLayerInputs in = render::rain_layer_inputs(frame, layer_h, occluders, lamps);
       // The cabin's tiles, as the pass has them (made once per camera there).
-      if (cabin.empty()) {
+      if (view == sim::View::kCockpit && cabin.empty()) {
         cabin = render::cabin_tiles(model::default_cabin(state.glass).mesh, camera, layer_w,
                                     layer_h, render::RainLayer::kTile);
       }
@@ -100,10 +105,11 @@ int main(int argc, char** argv) {
       splashes.push_back(static_cast<double>(state.rain.splashes.size()));
     }
     std::printf(
-        "{\"rain_streak_count\": %u, \"size\": \"%dx%d\", \"streaks_drawn\": %.0f, "
+        "{\"view\": \"%s\", \"rain_streak_count\": %u, \"size\": \"%dx%d\", \"streaks_drawn\": "
+        "%.0f, "
         "\"splashes\": %.0f, \"layer_ms\": %.3f, \"layer_ms_p90\": %.3f}\n",
-        count, width, height, percentile(streaks, 0.5), percentile(splashes, 0.5),
-        percentile(ms, 0.5), percentile(ms, 0.9));
+        view_name.c_str(), count, width, height, percentile(streaks, 0.5),
+        percentile(splashes, 0.5), percentile(ms, 0.5), percentile(ms, 0.9));
   }
   return 0;
 }

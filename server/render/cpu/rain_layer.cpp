@@ -69,10 +69,13 @@ struct RainLayer::Batch {
   float far_fade[kBatch], top_fade[kBatch];
   float head_x[kBatch], head_y[kBatch], head_z[kBatch];
   float motion_x[kBatch], motion_y[kBatch], motion_z[kBatch], reach[kBatch];
-  // Per copy and drop: the streak on the layer, or alpha 0 where none is drawn.
-  float hx[kMaxCopies][kBatch], hy[kMaxCopies][kBatch], tx[kMaxCopies][kBatch],
-      ty[kMaxCopies][kBatch], depth[kMaxCopies][kBatch], alpha[kMaxCopies][kBatch],
-      width[kMaxCopies][kBatch];
+  // The copy being drawn, per drop: its streak's head on the layer, its depth, opacity (0 where
+  // none is drawn) and width, and its line along the major axis (x_major: the layer's x), from a0
+  // to a1 >= a0, across from b0 by slope per texel along.
+  float hx[kBatch], hy[kBatch], depth[kBatch], alpha[kBatch], width[kBatch];
+  float a0[kBatch], a1[kBatch], b0[kBatch], b1[kBatch], slope[kBatch];
+  std::int32_t x_major[kBatch];
+  std::uint16_t visible[kBatch];  // the drops whose copy is drawn
 };
 
 // The haze's transmittance by distance, in a table per build (0-64 m, this view's haze).
@@ -84,10 +87,11 @@ static_assert(kHazeStepCm == static_cast<std::uint32_t>(kHazeStepM * 100.0f));
 struct RainLayer::Frame {
   Frame(const sim::RainState& rain, const RainLayerInputs& in, int width, int height);
 
-  // Every copy of every drop of the batch as branch-free arithmetic over arrays, which the
-  // compiler turns into vector code: the projection, the cull and the opacity.
+  // Every drop of the batch, then its copy c, as branch-free arithmetic over arrays, which the
+  // compiler turns into vector code: the projection, the cull, the opacity and the line's set-up.
   void project(Batch& b, int n) const;
-  // The lamps' light on a drop at p (camera frame), in levels (Texel::lit).
+  void project_copy(Batch& b, int n, int c) const;
+  // The lamps' light on a drop at p (camera frame), in levels (Texels::lit).
   std::uint32_t lamp_level(const glm::vec3& p) const;
 
   const sim::RainState& rain;
@@ -176,7 +180,10 @@ void RainLayer::Frame::project(Batch& b, int n) const {
         (rain.box_half_m.x - glm::dot(rel, rain.box_forward)) * (1.0f / 8.0f), 0.0f, 1.0f);
     b.top_fade[i] = std::clamp((rain.box_half_m.z - rel.z) * (1.0f / 1.5f), 0.0f, 1.0f);
   }
-  for (int c = 0; c < copy_count; ++c) {
+}
+
+void RainLayer::Frame::project_copy(Batch& b, int n, int c) const {
+  {
     const glm::vec3 offset = copies[c].offset_v;
     const float behind = copies[c].behind ? 1.0f : 0.0f;
     for (int i = 0; i < n; ++i) {
@@ -216,10 +223,20 @@ void RainLayer::Frame::project(Batch& b, int n) const {
                                           : 0.25f;
       const float fade = std::max(behind, b.far_fade[i]) * b.top_fade[i];
       const float alpha = opacity * level * fade * (0.35f + 0.65f * core) * spread;
-      b.hx[c][i] = hx, b.hy[c][i] = hy, b.tx[c][i] = tx, b.ty[c][i] = ty;
-      b.depth[c][i] = depth;
-      b.alpha[c][i] = visible ? alpha : 0.0f;
-      b.width[c][i] = true_width;
+      b.hx[i] = hx, b.hy[i] = hy;
+      b.depth[i] = depth;
+      b.alpha[i] = visible ? alpha : 0.0f;
+      b.width[i] = true_width;
+      // The Wu line's set-up (draw_streak): along the major axis from its lower end.
+      const bool x_major = std::abs(tx - hx) >= std::abs(ty - hy);
+      const float a_head = x_major ? hx : hy, a_tail = x_major ? tx : ty;
+      const float b_head = x_major ? hy : hx, b_tail = x_major ? ty : tx;
+      const bool swap = a_tail < a_head;
+      const float a0 = swap ? a_tail : a_head, a1 = swap ? a_head : a_tail;
+      const float b0 = swap ? b_tail : b_head, b1 = swap ? b_head : b_tail;
+      b.a0[i] = a0, b.a1[i] = a1, b.b0[i] = b0, b.b1[i] = b1;
+      b.slope[i] = a1 - a0 > 1e-6f ? (b1 - b0) / std::max(a1 - a0, 1e-6f) : 0.0f;
+      b.x_major[i] = x_major ? 1 : 0;
     }
   }
 }
@@ -251,10 +268,12 @@ void RainLayer::reset(int width, int height) {
   if (width != width_ || height != height_) {
     width_ = width;
     height_ = height;
-    texels_.assign(texels, Texel{});
+    texels_.sum.assign(texels, Texel{});
+    texels_.lit.assign(texels, 0);
     occluder_depth_.assign(texels, kUntouched);
     occluded_ = Bounds{};
-    second_.assign(texels, Texel{});
+    second_.sum.assign(texels, Texel{});
+    second_.lit.assign(texels, 0);
     colour_.assign(texels, 0u);
     tiles_x_ = (width + kTile - 1) / kTile;
     tile_lit_.assign(static_cast<std::size_t>(tiles_x_) * ((height + kTile - 1) / kTile), 0);
@@ -292,14 +311,14 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
     std::uint32_t drawn_second = 0;
     helper_.start([&] {
       drawn_second = draw(f, 0, second, second_, dirty_second, *batches_[1]);
-      dirty_splashes = draw_splashes(rain, in, f.view, f.sx, f.sy, f.cx, f.cy, second_);
+      dirty_splashes = draw_splashes(rain, in, f.view, f.sx, f.sy, f.cx, f.cy, second_.sum);
     });
     drawn = draw(f, second, n, texels_, dirty_first, *batches_[0]);
     helper_.wait();
     drawn += drawn_second;
   } else {
     drawn = draw(f, 0, n, texels_, dirty_first, *batches_[0]);
-    dirty_splashes = draw_splashes(rain, in, f.view, f.sx, f.sy, f.cx, f.cy, texels_);
+    dirty_splashes = draw_splashes(rain, in, f.view, f.sx, f.sy, f.cx, f.cy, texels_.sum);
   }
 
   // The texels with rain: the dirty rectangles of both threads and of the splashes.
@@ -317,8 +336,8 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
   return drawn;
 }
 
-std::uint32_t RainLayer::draw(const Frame& f, std::size_t begin, std::size_t end,
-                              std::vector<Texel>& out, Bounds& dirty, Batch& bt) const {
+std::uint32_t RainLayer::draw(const Frame& f, std::size_t begin, std::size_t end, Texels& out,
+                              Bounds& dirty, Batch& bt) const {
   // Each thread works through its drops in batches, in two phases: first every copy of every drop
   // of the batch as vector code (Frame::project); then the streaks that came out visible, one by
   // one, as Wu lines.
@@ -334,42 +353,41 @@ std::uint32_t RainLayer::draw(const Frame& f, std::size_t begin, std::size_t end
     }
     f.project(bt, n);
     for (int c = 0; c < f.copy_count; ++c) {
+      f.project_copy(bt, n, c);
+      // The visible streaks' indices first, without a branch (about half of the copies are
+      // visible, at random: a branch per copy would mispredict often).
+      int visible = 0;
       for (int i = 0; i < n; ++i) {
-        if (!(bt.alpha[c][i] > 0.0f)) continue;
-        ++drawn;
-        draw_streak(f, bt, c, i, out, touched);
+        bt.visible[visible] = static_cast<std::uint16_t>(i);
+        visible += bt.alpha[i] > 0.0f;
       }
+      drawn += static_cast<std::uint32_t>(visible);
+      for (int v = 0; v < visible; ++v) draw_streak(f, bt, bt.visible[v], out, touched);
     }
   }
   dirty = touched.empty() ? Bounds{} : touched;
   return drawn;
 }
 
-void RainLayer::draw_streak(const Frame& f, const Batch& bt, int c, int i, std::vector<Texel>& out,
+void RainLayer::draw_streak(const Frame& f, const Batch& bt, int i, Texels& out,
                             Bounds& touched) const {
   const int width = f.width, height = f.height;
-  const float hx = bt.hx[c][i], hy = bt.hy[c][i], tx = bt.tx[c][i], ty = bt.ty[c][i];
-  const float depth = bt.depth[c][i], true_width = bt.width[c][i];
-  const float units = bt.alpha[c][i] * kAlphaUnits;
+  const float depth = bt.depth[i], true_width = bt.width[i];
+  const float units = bt.alpha[i] * kAlphaUnits;
   const auto whole = static_cast<std::uint32_t>(units + 0.5f);
   const std::uint16_t depth_c = depth_cm(depth);
-  const float dx = tx - hx, dy = ty - hy;
   // The lamps' light at the streak's head (back from the screen to the camera's frame).
   const std::uint32_t level =
-      f.lamp_count
-          ? f.lamp_level(glm::vec3((hx - f.cx) / f.sx * depth, (hy - f.cy) / f.sy * depth, -depth))
-          : 0;
+      f.lamp_count ? f.lamp_level(glm::vec3((bt.hx[i] - f.cx) / f.sx * depth,
+                                            (bt.hy[i] - f.cy) / f.sy * depth, -depth))
+                   : 0;
 
   // A Wu line, clipped to the layer: one texel a column along its major axis, shared by the
   // two nearest across (and whole texels between them for a drop wider than a texel).
-  const bool x_major = std::abs(dx) >= std::abs(dy);
-  float a0 = x_major ? hx : hy, a1 = x_major ? tx : ty;  // along the major axis
-  float b0 = x_major ? hy : hx, b1 = x_major ? ty : tx;  // across
-  if (a1 < a0) {
-    std::swap(a0, a1);
-    std::swap(b0, b1);
-  }
-  const float slope = a1 - a0 > 1e-6f ? (b1 - b0) / (a1 - a0) : 0.0f;
+  const bool x_major = bt.x_major[i] != 0;
+  const float a0 = bt.a0[i], a1 = bt.a1[i];  // along the major axis, a0 <= a1
+  const float b0 = bt.b0[i], b1 = bt.b1[i];  // across, at a0 and a1
+  const float slope = bt.slope[i];
   const int major_size = x_major ? width : height, minor_size = x_major ? height : width;
   int first = std::max(0, static_cast<int>(std::floor(a0)));
   int last = std::min({major_size - 1, static_cast<int>(std::floor(a1)), first + f.max_steps});
@@ -421,16 +439,21 @@ void RainLayer::draw_streak(const Frame& f, const Batch& bt, int c, int i, std::
   // occluders' depths, or null for a streak that lies wholly outside them).
   auto put = [&](std::size_t k, std::uint32_t alpha) {
     if (occ && depth_c > occ[k]) return;
-    add(out[k], alpha, depth_c, level);
+    add(out.sum[k], alpha, depth_c);
+    if (level) add_lit(out.lit[k], alpha, level);
   };
-  for (int m = first; m <= last; ++m) {
-    // Evaluated afresh at each column (not summed), so that it stays between its ends.
-    const float b = b_at(static_cast<float>(m));
-    const int base = std::clamp(static_cast<int>(b), base_lo, base_hi);
-    const float frac = std::clamp(b - static_cast<float>(base), 0.0f, 1.0f);
+  // b(m) in 1/65536 texel, stepped in integers: exact but for the rounding of its start and
+  // slope (a few 1/65536 over a streak), which the clamps absorb.
+  constexpr float kFixed = 65536.0f;
+  std::int32_t b_fixed =
+      static_cast<std::int32_t>(std::lround(b_at(static_cast<float>(first)) * kFixed));
+  const auto b_step = static_cast<std::int32_t>(std::lround(slope * kFixed));
+  for (int m = first; m <= last; ++m, b_fixed += b_step) {
+    const int base = std::clamp(b_fixed >> 16, base_lo, base_hi);
+    const auto frac = static_cast<std::uint32_t>(std::clamp(b_fixed - (base << 16), 0, 1 << 16));
     std::size_t k = m * major_stride + (base - extra) * minor_stride;
-    const auto far_share = static_cast<std::uint32_t>(units * frac + 0.5f);
-    put(k, whole - std::min(far_share, whole));
+    const std::uint32_t far_share = (whole * frac + (1u << 15)) >> 16;
+    put(k, whole - far_share);
     for (int e = 1 - extra; e <= extra; ++e) {
       k += minor_stride;
       put(k, whole);
@@ -485,8 +508,10 @@ void RainLayer::resolve_rows(const Frame& f, const RainLayerInputs& in, const Bo
   const int x0 = b.x0, n = b.x1 - b.x0;
   for (int y = y0; y < y1; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * width_ + x0;
-    Texel* first = &texels_[row];
-    Texel* second = &second_[row];
+    Texel* first = &texels_.sum[row];
+    Texel* second = &second_.sum[row];
+    std::uint16_t* first_lit = &texels_.lit[row];
+    std::uint16_t* second_lit = &second_.lit[row];
     std::uint32_t* out = &colour_[row];
     const std::uint8_t* hidden_row =
         cabin ? &in.cabin_tiles[static_cast<std::size_t>(y / kTile) * tiles_x_] : nullptr;
@@ -504,9 +529,10 @@ void RainLayer::resolve_rows(const Frame& f, const RainLayerInputs& in, const Bo
       const std::uint32_t sum = std::uint32_t{first[i].alpha} + second[i].alpha;
       const std::uint32_t depth = std::min(first[i].depth, second[i].depth);
       const std::uint32_t a = coverage.at_units(sum);
-      const std::uint32_t lit = std::uint32_t{first[i].lit} + second[i].lit;
       const std::uint32_t level =
-          levels > 1 ? std::min<std::uint32_t>(lit * kLitLevels / std::max(sum, 1u), kLitLevels - 1)
+          levels > 1 ? std::min<std::uint32_t>((std::uint32_t{first_lit[i]} + second_lit[i]) *
+                                                   kLitLevels / std::max(sum, 1u),
+                                               kLitLevels - 1)
                      : 0;
       const glm::uvec3& c = hazed_[level * (kHazeSteps + 1) +
                                    std::min(depth / kHazeStepCm, std::uint32_t{kHazeSteps})];
@@ -517,6 +543,10 @@ void RainLayer::resolve_rows(const Frame& f, const RainLayerInputs& in, const Bo
     // Left clear for the next frame.
     std::fill_n(first, n, Texel{});
     std::fill_n(second, n, Texel{});
+    if (levels > 1) {
+      std::fill_n(first_lit, n, std::uint16_t{0});
+      std::fill_n(second_lit, n, std::uint16_t{0});
+    }
     // Each tile of the row with rain, and which of its edges has rain (bilinear magnification
     // carries a quarter of an edge texel into the next tile's first pixels).
     std::uint8_t* tiles = &tile_lit_[static_cast<std::size_t>(y / kTile) * tiles_x_];

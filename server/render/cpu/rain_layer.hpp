@@ -111,16 +111,22 @@ class RainLayer {
  private:
   // What the streaks leave in a texel: one cache access per texel drawn. Every drop carries the
   // same light, so a texel needs only how much of it and the distance of its nearest streak, for
-  // the haze between and the occluders. In 16-bit integers: the two threads' layers (and the
-  // occluders' depths) then take half the cache, which matters in a frame whose other passes have
-  // evicted them (in the quiet microbenchmark floats drew as fast; with the cache cold between
-  // frames the layer took 0.3-0.5 ms more at 10,000 streaks).
+  // the haze between and the occluders. In 16-bit integers, four bytes a texel: the two threads'
+  // layers (and the occluders' depths) then take little of the cache, which matters in a frame
+  // whose other passes have evicted them (in the quiet microbenchmark floats drew as fast; with the
+  // cache cold between frames the layer took 0.3-0.5 ms more at 10,000 streaks). The lamps' light
+  // is apart (Texels::lit): only a streak a lamp lights touches it.
   static constexpr std::uint16_t kUntouched = 0xffff;  // depth of a texel no streak has touched
   static constexpr float kAlphaUnits = 4096.0f;        // opacity's units: sums up to 16
   struct Texel {
     std::uint16_t alpha = 0;           // sum of the streaks' opacities, saturating
     std::uint16_t depth = kUntouched;  // nearest streak (cm)
-    std::uint16_t lit = 0;  // sum of the opacities times their lamp light's level / kLitLevels
+  };
+  // One thread's texels, and per texel the sum of the opacities times their lamp light's level /
+  // kLitLevels (0 where no lit streak was drawn).
+  struct Texels {
+    std::vector<Texel> sum;
+    std::vector<std::uint16_t> lit;
   };
   // A streak's lamp light in levels, 0 .. kLitLevels - 1, of up to kLitMax radiance (squared:
   // finer where it is dim).
@@ -129,11 +135,13 @@ class RainLayer {
   static std::uint16_t depth_cm(float depth_m) {
     return static_cast<std::uint16_t>(std::clamp(depth_m * 100.0f + 0.5f, 0.0f, 65534.0f));
   }
-  static void add(Texel& t, std::uint32_t alpha, std::uint16_t depth, std::uint32_t level = 0) {
+  static void add(Texel& t, std::uint32_t alpha, std::uint16_t depth) {
     t.alpha = static_cast<std::uint16_t>(std::min<std::uint32_t>(t.alpha + alpha, 0xffff));
     t.depth = std::min(t.depth, depth);
-    t.lit = static_cast<std::uint16_t>(
-        std::min<std::uint32_t>(t.lit + alpha * level / kLitLevels, 0xffff));
+  }
+  static void add_lit(std::uint16_t& lit, std::uint32_t alpha, std::uint32_t level) {
+    lit = static_cast<std::uint16_t>(
+        std::min<std::uint32_t>(lit + alpha * level / kLitLevels, 0xffff));
   }
   // The most whole texels across a streak between its two shared ones (a drop a few texels
   // wide, just past kNearestM).
@@ -160,11 +168,11 @@ class RainLayer {
   void reset(int width, int height);
   // Draws drops [begin, end) into `out`, in batches; `dirty` gets the texels it touched. Returns
   // the streaks drawn.
-  std::uint32_t draw(const Frame& f, std::size_t begin, std::size_t end, std::vector<Texel>& out,
-                     Bounds& dirty, Batch& batch) const;
-  // One streak (copy c of drop i of the batch) as a Wu line into `out`, widening `touched`.
-  void draw_streak(const Frame& f, const Batch& batch, int c, int i, std::vector<Texel>& out,
-                   Bounds& touched) const;
+  std::uint32_t draw(const Frame& f, std::size_t begin, std::size_t end, Texels& out, Bounds& dirty,
+                     Batch& batch) const;
+  // One streak (drop i of the batch, in the copy being drawn) as a Wu line into `out`, widening
+  // `touched`.
+  void draw_streak(const Frame& f, const Batch& batch, int i, Texels& out, Bounds& touched) const;
   // The texels of `b` to premultiplied colour, both threads' texels summed and cleared, and the
   // tiles with rain marked.
   void resolve(const Frame& f, const RainLayerInputs& in, const Bounds& b);
@@ -189,8 +197,8 @@ class RainLayer {
   sim::WorkerThread helper_{"dp-rain"};
   // Each thread's batch of drops being projected (rain_layer.cpp), made once.
   std::unique_ptr<Batch> batches_[2];  // draws half the drops, resolves half the rows
-  std::vector<Texel> texels_;
-  std::vector<Texel> second_;  // the second thread's
+  Texels texels_;
+  Texels second_;  // the second thread's
   std::vector<std::uint32_t> colour_;
   Bounds bounds_;  // the texels the last build wrote to colour_, cleared by the next
   // Per tile: whether a texel has rain, and which of its edges (cleared once the runs are made).
