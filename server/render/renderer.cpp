@@ -620,9 +620,16 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
     m.timed(pass->decl().name, [&] { m.run_pass(*pass, frame, s, resources); });
   if (lists(frame_passes, m.passes.lamp_map)) m.lamp_map_of = v.begun;
   // The passes that need only the frame's inputs: those before the first that reads the step.
+  // The rain's layer is built meanwhile, on the CPU, on threads of its own.
   m.passes.rain->take_drawn();
-  while (v.next_pass < v.passes->size() && !(*v.passes)[v.next_pass]->decl().reads_step)
-    m.run_view_pass(v, (*v.passes)[v.next_pass++]);
+  if (lists(*v.passes, m.passes.rain)) m.passes.rain->start(frame);
+  try {
+    while (v.next_pass < v.passes->size() && !(*v.passes)[v.next_pass]->decl().reads_step)
+      m.run_view_pass(v, (*v.passes)[v.next_pass++]);
+  } catch (...) {
+    m.passes.rain->finish_build();  // it reads the frame's rain
+    throw;
+  }
   // To the rasterizer now, before this thread waits for the step or draws another view:
   // llvmpipe bins a frame's draws and rasterizes them only once they are flushed, so a core would
   // otherwise idle through the wait (in the demo, a fifth of the tick).

@@ -126,7 +126,9 @@ RainLayerInputs rain_layer_inputs(const FrameContext& frame, int layer_height,
   return in;
 }
 
-void RainPass::execute(const FrameContext& frame, const FrameResources&) {
+void RainPass::start(const FrameContext& frame) {
+  finish_build();
+  if (!wanted(frame)) return;
   const sim::RainState& rain = frame.rain();
   const int width = (frame.spec.width + kLayerDivisor - 1) / kLayerDivisor;
   const int height = (frame.spec.height + kLayerDivisor - 1) / kLayerDivisor;
@@ -149,14 +151,32 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
     in.cabin_tiles = cabin_tiles_for(frame, width, height);
   }
   Sized& sized = this->sized(width, height);
-  RainLayer& layer = sized.layer;
+  building_ = Building{&sized, &rain, in};
+  builder_.start([this] {
+    Building& b = *building_;
+    const auto t0 = std::chrono::steady_clock::now();
+    b.streaks = b.sized->layer.build(*b.rain, b.in, b.sized->width, b.sized->height);
+    b.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  });
+}
+
+void RainPass::finish_build() {
+  builder_.wait();
+  building_.reset();
+}
+
+void RainPass::execute(const FrameContext& frame, const FrameResources&) {
+  if (!building_) start(frame);  // (a pass run alone, as the tests do)
   // The passes drawn so far go to llvmpipe's rasterizer threads now, rather than wait in its bins
-  // while this thread builds the layer (some 3.5 ms at 640x360): the cores share the two.
+  // while the layer is finished: the cores share the two.
   glFlush();
-  const auto t0 = std::chrono::steady_clock::now();
-  drawn_.streaks = layer.build(rain, in, width, height);
-  drawn_.layer_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  builder_.wait();
+  Sized& sized = *building_->sized;
+  drawn_.streaks = building_->streaks;
+  drawn_.layer_ms = building_->ms;
+  building_.reset();
+  RainLayer& layer = sized.layer;
+  const int width = sized.width, height = sized.height;
 
   const Texture& texture = sized.colour[sized.next];
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -40,6 +41,13 @@ class RainPass final : public Pass {
   const PassDecl& decl() const override { return decl_; }
   bool wanted(const FrameContext& frame) const override;
   void execute(const FrameContext& frame, const FrameResources& resources) override;
+  // Starts building the frame's layer (its CPU work, some milliseconds) on a thread of the pass's
+  // own, so that it runs while the render thread draws the passes before the rain; execute() takes
+  // it. Nothing where the frame has no rain. The frame's rain state must outlive the build: a
+  // frame that ends before its rain pass (a throw) calls finish_build().
+  void start(const FrameContext& frame);
+  // Waits for a build started and drops it.
+  void finish_build();
 
   // The layer's size: the view's over this, each way.
   static constexpr int kLayerDivisor = 2;
@@ -102,6 +110,16 @@ class RainPass final : public Pass {
   std::vector<glm::vec4> runs_uv_;
   VertexArray vao_;  // none of its own attributes: rain.vert reads the runs
   Drawn drawn_;
+  // The build in flight (start()), and the thread it runs on: its second half on the layer's own.
+  struct Building {
+    Sized* sized = nullptr;
+    const sim::RainState* rain = nullptr;
+    RainLayerInputs in;
+    std::uint32_t streaks = 0;  // the build's, once finished
+    double ms = 0.0;
+  };
+  std::optional<Building> building_;
+  sim::WorkerThread builder_{"dp-rain-build"};
 };
 
 // RAIN view: the rain layer alone over black. The scene's passes before it leave their depth, so
