@@ -1,6 +1,8 @@
 // The rain layer on the CPU (no GL): a box hides the streaks behind it and not those in front of
 // it, on the texels inside its outline; the composite's runs of tiles cover every texel with rain
-// and, for rain in one part of the view, little else; the cabin's tiles are left out or put apart.
+// and, for rain in one part of the view, little else; the cabin's tiles are left out or put apart;
+// a lamp's light leaves nothing for the next frame; long streaks at every slope, up to the view's
+// edges, stay in the layer.
 #include "server/render/cpu/rain_layer.hpp"
 
 #include "server/render/cpu/cabin_tiles.hpp"
@@ -65,6 +67,64 @@ TEST(RainLayerTest, ABoxHidesTheDropsBehindItAndNotThoseInFront) {
     }
     in.occluders = {};
   }
+}
+
+// Drops on a grid over the whole view, from 2 to 20 m ahead.
+std::vector<glm::vec3> everywhere() {
+  std::vector<glm::vec3> out;
+  for (int i = 0; i < 4000; ++i) {
+    const float x = 2.0f + 18.0f * static_cast<float>(i % 97) / 96.0f;
+    const float across = (static_cast<float>(i % 61) / 30.0f - 1.0f) * 1.8f * x;
+    const float up = (static_cast<float>(i % 37) / 18.0f - 1.0f) * 0.6f * x;
+    out.emplace_back(x, across, up);
+  }
+  return out;
+}
+
+TEST(RainLayerTest, ALampsLightLeavesNothingForTheNextFrame) {
+  // A lamp at the camera shining ahead (the lit texels are kept apart from the rest).
+  RainLamp lamp;
+  lamp.position = glm::vec3(0.0f);
+  lamp.axis = glm::vec3(0.0f, 0.0f, -1.0f);
+  lamp.intensity = 50.0f;
+  lamp.cos_outer = 0.8f;
+  lamp.cos_inner = 0.95f;
+  RainLayerInputs dark = inputs(), lit = inputs();
+  lit.lamp_colour = glm::vec3(1.0f, 0.2f, 0.2f);
+  lit.lamps = std::span<const RainLamp>(&lamp, 1);
+  const sim::RainState rain = rain_at(everywhere());
+  RainLayer fresh_dark, fresh_lit, layer;
+  fresh_dark.build(rain, dark, kWidth, kHeight);
+  fresh_lit.build(rain, lit, kWidth, kHeight);
+  ASSERT_NE(fresh_dark.colour(), fresh_lit.colour()) << "the lamp lights the drops";
+  layer.build(rain, lit, kWidth, kHeight);
+  layer.build(rain, dark, kWidth, kHeight);
+  EXPECT_EQ(layer.colour(), fresh_dark.colour()) << "no lamp after a lit frame";
+  layer.build(rain, lit, kWidth, kHeight);
+  layer.build(rain, lit, kWidth, kHeight);
+  EXPECT_EQ(layer.colour(), fresh_lit.colour()) << "a lit frame after a lit frame";
+}
+
+TEST(RainLayerTest, LongStreaksAtEverySlopeStayInTheLayer) {
+  // The camera driving at 40 m/s through drops falling slantwise, exposed for a tenth of a second:
+  // streaks tens of texels long at every angle, many of them crossing the view's edges (the
+  // sanitizers' build checks every write).
+  RainLayerInputs in = inputs();
+  in.exposure_s = 0.1;
+  in.camera_velocity = glm::dvec3(40.0, 3.0, 0.0);
+  sim::RainState rain = rain_at(everywhere());
+  rain.fall_direction = glm::normalize(glm::vec3(0.2f, 0.5f, -1.0f));
+  rain.wind_mps = glm::vec3(0.0f, -6.0f, 0.0f);
+  RainLayer layer;
+  EXPECT_GT(layer.build(rain, in, kWidth, kHeight), 3000u);
+  int corners[4] = {};
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      if (layer.colour()[static_cast<std::size_t>(y) * kWidth + x] != 0u)
+        ++corners[(y < kHeight / 2 ? 0 : 2) + (x < kWidth / 2 ? 0 : 1)];
+    }
+  }
+  for (int q = 0; q < 4; ++q) EXPECT_GT(corners[q], kWidth * kHeight / 16) << "quarter " << q;
 }
 
 TEST(RainLayerTest, TheRunsCoverEveryTexelWithRainAndLittleElse) {
