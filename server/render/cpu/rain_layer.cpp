@@ -442,14 +442,16 @@ void RainLayer::draw_streak(const Frame& f, const Batch& bt, int i, Texels& out,
     add(out.sum[k], alpha, depth_c);
     if (level) add_lit(out.lit[k], alpha, level);
   };
-  // b(m) in 1/65536 texel, stepped in integers: exact but for the rounding of its start and
-  // slope (a few 1/65536 over a streak), which the clamps absorb.
+  // b(m) in 1/65536 texel, stepped in integers: off the line by the rounding of its start and
+  // slope (at most 1/65536 a column, under a hundredth of a texel over the longest streak). The
+  // clamp to the ends' texels keeps every write inside the bounds found above (`touched` and the
+  // occluders' test).
   constexpr float kFixed = 65536.0f;
   std::int32_t b_fixed =
       static_cast<std::int32_t>(std::lround(b_at(static_cast<float>(first)) * kFixed));
   const auto b_step = static_cast<std::int32_t>(std::lround(slope * kFixed));
   for (int m = first; m <= last; ++m, b_fixed += b_step) {
-    const int base = std::clamp(b_fixed >> 16, base_lo, base_hi);
+    const int base = std::clamp(b_fixed >> 16, b_min, b_max);
     const auto frac = static_cast<std::uint32_t>(std::clamp(b_fixed - (base << 16), 0, 1 << 16));
     std::size_t k = m * major_stride + (base - extra) * minor_stride;
     const std::uint32_t far_share = (whole * frac + (1u << 15)) >> 16;

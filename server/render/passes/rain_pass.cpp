@@ -154,9 +154,14 @@ void RainPass::start(const FrameContext& frame) {
   building_ = Building{&sized, &rain, in};
   builder_.start([this] {
     Building& b = *building_;
-    const auto t0 = std::chrono::steady_clock::now();
-    b.streaks = b.sized->layer.build(*b.rain, b.in, b.sized->width, b.sized->height);
-    b.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    try {
+      const auto t0 = std::chrono::steady_clock::now();
+      b.streaks = b.sized->layer.build(*b.rain, b.in, b.sized->width, b.sized->height);
+      b.ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    } catch (...) {
+      b.failure = std::current_exception();  // (an allocation), for execute() to throw
+    }
   });
 }
 
@@ -171,6 +176,12 @@ void RainPass::execute(const FrameContext& frame, const FrameResources&) {
   // while the layer is finished: the cores share the two.
   glFlush();
   builder_.wait();
+  if (!building_) return;  // no rain after all
+  if (building_->failure) {
+    const std::exception_ptr failure = building_->failure;
+    building_.reset();
+    std::rethrow_exception(failure);
+  }
   Sized& sized = *building_->sized;
   drawn_.streaks = building_->streaks;
   drawn_.layer_ms = building_->ms;

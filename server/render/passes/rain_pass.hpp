@@ -1,5 +1,6 @@
 #pragma once
 
+#include <exception>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -117,6 +118,7 @@ class RainPass final : public Pass {
     RainLayerInputs in;
     std::uint32_t streaks = 0;  // the build's, once finished
     double ms = 0.0;
+    std::exception_ptr failure;  // what it threw
   };
   std::optional<Building> building_;
   sim::WorkerThread builder_{"dp-rain-build"};
