@@ -71,6 +71,11 @@ void throw_gl_error(sim::View view) {
 // A view between begin() and end(): its frame, its target, and where its passes stand.
 struct Renderer::ViewFrame::State {
   explicit State(const sim::ViewSpec& spec) : spec(spec) {}
+  // A rain layer still being built for the frame reads its rain: it is waited for, however the
+  // frame ends (a throw in a pass, or in the scheduler between begin() and end()).
+  ~State() {
+    if (rain_pass && frame) rain_pass->finish_build(*frame);
+  }
   const sim::ViewSpec& spec;
   RenderSession* session = nullptr;
   int view_index = 0;
@@ -89,7 +94,8 @@ struct Renderer::ViewFrame::State {
   std::uint64_t begun = 0;    // its serial: Renderer::Impl::views_begun when it began
   std::array<bool, kResourceCount> written{};
   std::vector<PassTiming> timings;
-  RainPass::Drawn rain;  // what its rain pass drew (in begin())
+  RainPass::Drawn rain;           // what its rain pass drew
+  RainPass* rain_pass = nullptr;  // the pass building its layer (RainPass::start)
   bool ended = false;
 };
 
@@ -621,14 +627,19 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
   if (lists(frame_passes, m.passes.lamp_map)) m.lamp_map_of = v.begun;
   // The passes that need only the frame's inputs: those before the first that reads the step.
   // The rain's layer is built meanwhile, on the CPU, on threads of its own.
+  // Where the layer is not built yet when its pass comes, that pass and those after it wait for
+  // end(), so that this thread draws the next view's passes meanwhile (each view's passes keep
+  // their order).
   m.passes.rain->take_drawn();
-  if (lists(*v.passes, m.passes.rain)) m.passes.rain->start(frame);
-  try {
-    while (v.next_pass < v.passes->size() && !(*v.passes)[v.next_pass]->decl().reads_step)
-      m.run_view_pass(v, (*v.passes)[v.next_pass++]);
-  } catch (...) {
-    m.passes.rain->finish_build();  // it reads the frame's rain
-    throw;
+  if (lists(*v.passes, m.passes.rain)) {
+    m.passes.rain->start(frame);
+    v.rain_pass = m.passes.rain;
+  }
+  while (v.next_pass < v.passes->size()) {
+    Pass* pass = (*v.passes)[v.next_pass];
+    if (pass->decl().reads_step || (pass == m.passes.rain && !m.passes.rain->built(frame))) break;
+    m.run_view_pass(v, pass);
+    ++v.next_pass;
   }
   // To the rasterizer now, before this thread waits for the step or draws another view:
   // llvmpipe bins a frame's draws and rasterizes them only once they are flushed, so a core would
@@ -662,9 +673,11 @@ PendingReadback Renderer::end(ViewFrame& view) {
     if (m.lamps_of != v.begun) m.set_view(v);
     v.lamp_map_stale = lists(m.frame_passes(spec), m.passes.lamp_map) && m.lamp_map_of != v.begun;
   }
+  m.passes.rain->take_drawn();
   while (v.next_pass < v.passes->size()) m.run_view_pass(v, (*v.passes)[v.next_pass++]);
   if (v.wants_clean && !v.clean_taken) m.take_clean(v);  // a view that adds no water
-  // (The rain pass reads no step: it is drawn in begin().)
+  // The rain pass, where begin() left it to this.
+  if (const RainPass::Drawn late = m.passes.rain->take_drawn(); late.streaks > 0) v.rain = late;
   const RainPass::Drawn& rain = v.rain;
   m.rain_streaks = rain.streaks;
   // The rain pass's CPU layer, beside the whole pass, for the budget table.

@@ -22,6 +22,7 @@ RainPass::RainPass(SharedResources& shared)
       program_("rain.vert", "rain.frag"),
       u_plane_depth_(program_.uniform("u_plane_depth")) {
   vao_ = make_vertex_array();
+  for (auto& lane : lanes_) lane = std::make_unique<Lane>();
 }
 
 bool RainPass::wanted(const FrameContext& frame) const {
@@ -126,68 +127,88 @@ RainLayerInputs rain_layer_inputs(const FrameContext& frame, int layer_height,
   return in;
 }
 
+RainPass::Lane* RainPass::lane_of(const FrameContext& frame) const {
+  for (const auto& lane : lanes_) {
+    if (lane->frame == &frame) return lane.get();
+  }
+  return nullptr;
+}
+
 void RainPass::start(const FrameContext& frame) {
-  finish_build();
+  finish_build(frame);
   if (!wanted(frame)) return;
+  // The lane least recently started; a build still in it (a frame that never took it) is dropped.
+  Lane& lane = *lanes_[next_lane_];
+  next_lane_ = (next_lane_ + 1) % kLanes;
+  if (lane.frame) finish_build(*lane.frame);
   const sim::RainState& rain = frame.rain();
   const int width = (frame.spec.width + kLayerDivisor - 1) / kLayerDivisor;
   const int height = (frame.spec.height + kLayerDivisor - 1) / kLayerDivisor;
-  RainLayerInputs in = rain_layer_inputs(frame, height, occluders_, lamps_);
+  RainLayerInputs in = rain_layer_inputs(frame, height, lane.occluders, lane.lamps);
   if (frame.spec.background == sim::Background::kClient) {
     // Hidden by what the picture shows nearer; no cabin of ours. A picture's own depth is taken
     // once a picture (its serial); the ground's moves with the car, every frame.
     const sim::ClientImage* image =
         frame.scene.client_images[static_cast<std::size_t>(frame.spec.view)].get();
     const std::uint64_t serial = image && !image->depth_m.empty() ? image->serial : 0;
-    if (serial == 0 || serial != scene_depth_serial_ ||
-        scene_depth_cm_.size() != static_cast<std::size_t>(width) * height) {
+    if (serial == 0 || serial != lane.scene_depth_serial ||
+        lane.scene_depth_cm.size() != static_cast<std::size_t>(width) * height) {
       picture_layer_depth_cm(image, picture_camera(frame.camera),
                              ground_plane(frame.camera, frame.scene.vehicle), width, height, 0xffff,
-                             scene_depth_cm_);
-      scene_depth_serial_ = serial;
+                             lane.scene_depth_cm);
+      lane.scene_depth_serial = serial;
     }
-    in.scene_depth_cm = scene_depth_cm_;
+    in.scene_depth_cm = lane.scene_depth_cm;
   } else if (is_driver_view(frame.spec.view)) {
-    in.cabin_tiles = cabin_tiles_for(frame, width, height);
+    const std::vector<std::uint8_t>& tiles = cabin_tiles_for(frame, width, height);
+    lane.cabin_tiles.assign(tiles.begin(), tiles.end());
+    in.cabin_tiles = lane.cabin_tiles;
   }
-  Sized& sized = this->sized(width, height);
-  building_ = Building{&sized, &rain, in};
-  builder_.start([this] {
-    Building& b = *building_;
+  lane.frame = &frame;
+  lane.rain = &rain;
+  lane.in = in;
+  lane.built.store(false, std::memory_order_relaxed);
+  lane.failure = nullptr;
+  lane.builder.start([&lane, width, height] {
     try {
       const auto t0 = std::chrono::steady_clock::now();
-      b.streaks = b.sized->layer.build(*b.rain, b.in, b.sized->width, b.sized->height);
-      b.ms =
+      lane.streaks = lane.layer.build(*lane.rain, lane.in, width, height);
+      lane.ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     } catch (...) {
-      b.failure = std::current_exception();  // (an allocation), for execute() to throw
+      lane.failure = std::current_exception();  // (an allocation), for execute() to throw
     }
+    lane.built.store(true, std::memory_order_release);
   });
 }
 
-void RainPass::finish_build() {
-  builder_.wait();
-  building_.reset();
+bool RainPass::built(const FrameContext& frame) const {
+  const Lane* lane = lane_of(frame);
+  return !lane || lane->built.load(std::memory_order_acquire);
+}
+
+void RainPass::finish_build(const FrameContext& frame) {
+  Lane* lane = lane_of(frame);
+  if (!lane) return;
+  lane->builder.wait();
+  lane->frame = nullptr;
 }
 
 void RainPass::execute(const FrameContext& frame, const FrameResources&) {
-  if (!building_) start(frame);  // (a pass run alone, as the tests do)
+  if (!lane_of(frame)) start(frame);  // (a pass run alone, as the tests do)
+  Lane* lane = lane_of(frame);
+  if (!lane) return;  // no rain after all
   // The passes drawn so far go to llvmpipe's rasterizer threads now, rather than wait in its bins
   // while the layer is finished: the cores share the two.
   glFlush();
-  builder_.wait();
-  if (!building_) return;  // no rain after all
-  if (building_->failure) {
-    const std::exception_ptr failure = building_->failure;
-    building_.reset();
-    std::rethrow_exception(failure);
-  }
-  Sized& sized = *building_->sized;
-  drawn_.streaks = building_->streaks;
-  drawn_.layer_ms = building_->ms;
-  building_.reset();
-  RainLayer& layer = sized.layer;
-  const int width = sized.width, height = sized.height;
+  lane->builder.wait();
+  lane->frame = nullptr;
+  if (lane->failure) std::rethrow_exception(std::exchange(lane->failure, nullptr));
+  drawn_.streaks = lane->streaks;
+  drawn_.layer_ms = lane->ms;
+  RainLayer& layer = lane->layer;
+  const int width = layer.width(), height = layer.height();
+  Sized& sized = this->sized(width, height);
 
   const Texture& texture = sized.colour[sized.next];
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);

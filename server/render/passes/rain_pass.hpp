@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <exception>
 #include <memory>
 #include <optional>
@@ -42,13 +43,16 @@ class RainPass final : public Pass {
   const PassDecl& decl() const override { return decl_; }
   bool wanted(const FrameContext& frame) const override;
   void execute(const FrameContext& frame, const FrameResources& resources) override;
-  // Starts building the frame's layer (its CPU work, some milliseconds) on a thread of the pass's
-  // own, so that it runs while the render thread draws the passes before the rain; execute() takes
-  // it. Nothing where the frame has no rain. The frame's rain state must outlive the build: a
-  // frame that ends before its rain pass (a throw) calls finish_build().
+  // Starts building the frame's layer (its CPU work, some milliseconds) on threads of the pass's
+  // own, so that it runs while the render thread draws the passes before the rain; execute()
+  // takes it. Two frames' layers may be built at once (a tick's two views). Nothing where the
+  // frame has no rain. The frame's rain state must outlive the build: a frame that ends before
+  // its rain pass (a throw) calls finish_build().
   void start(const FrameContext& frame);
-  // Waits for a build started and drops it.
-  void finish_build();
+  // Whether the frame's layer is built (or none was started for it).
+  bool built(const FrameContext& frame) const;
+  // Waits for a build started for the frame and drops it.
+  void finish_build(const FrameContext& frame);
 
   // The layer's size: the view's over this, each way.
   static constexpr int kLayerDivisor = 2;
@@ -76,10 +80,6 @@ class RainPass final : public Pass {
   SharedResources& shared_;
   ShaderProgram program_;
   Uniform u_plane_depth_;
-  std::vector<RainOccluder> occluders_;        // this frame's cars, for the layer
-  std::vector<RainLamp> lamps_;                // and its lamps
-  std::vector<std::uint16_t> scene_depth_cm_;  // and over a client's picture, its depth
-  std::uint64_t scene_depth_serial_ = 0;       // of the picture it is (0: the ground's)
   // The layer's tiles that the cabin hides, per driver's camera (cabin_tiles.hpp), the latest few.
   struct CabinTiles {
     int width = 0, height = 0;
@@ -93,15 +93,14 @@ class RainPass final : public Pass {
   const std::vector<std::uint8_t>& cabin_tiles_for(const FrameContext& frame, int width,
                                                    int height);
   std::vector<CabinTiles> cabin_tiles_;
-  // What a layer size needs: the layer, and textures and run buffers used in turn, as many as
-  // kUploadCopies (gl_objects.hpp) for each of two views of that size in a tick (the demo's).
-  // Kept per size for the latest few sizes (kSizesKept), so that sessions whose views differ in
-  // size, rendered in turn, re-create nothing; each layer has a helper thread of its own.
+  // What a layer size needs: textures and run buffers used in turn, as many as kUploadCopies
+  // (gl_objects.hpp) for each of two views of that size in a tick (the demo's). Kept per size for
+  // the latest few sizes (kSizesKept), so that sessions whose views differ in size, rendered in
+  // turn, re-create nothing.
   static constexpr std::size_t kSizesKept = 4;
   static constexpr int kLayerCopies = 2 * kUploadCopies;
   struct Sized {
     int width = 0, height = 0;
-    RainLayer layer;
     Texture colour[kLayerCopies];
     Buffer runs_buffer[kLayerCopies];  // the runs of tiles to draw, uv over the view (rain.vert)
     int next = 0;
@@ -111,17 +110,29 @@ class RainPass final : public Pass {
   std::vector<glm::vec4> runs_uv_;
   VertexArray vao_;  // none of its own attributes: rain.vert reads the runs
   Drawn drawn_;
-  // The build in flight (start()), and the thread it runs on: its second half on the layer's own.
-  struct Building {
-    Sized* sized = nullptr;
+  // A frame's build (start()): its layer and the thread it is built on (its second half on the
+  // layer's own), and what the layer reads, kept until the build is taken. Two, for a tick's two
+  // views.
+  struct Lane {
+    const FrameContext* frame = nullptr;  // the frame being built for, or none
     const sim::RainState* rain = nullptr;
     RainLayerInputs in;
-    std::uint32_t streaks = 0;  // the build's, once finished
+    std::vector<RainOccluder> occluders;  // the frame's cars, for the layer
+    std::vector<RainLamp> lamps;          // and its lamps
+    std::vector<std::uint8_t> cabin_tiles;
+    std::vector<std::uint16_t> scene_depth_cm;  // over a client's picture, its depth
+    std::uint64_t scene_depth_serial = 0;       // of the picture it is (0: the ground's)
+    RainLayer layer;
+    std::atomic<bool> built{false};
+    std::uint32_t streaks = 0;  // the build's, once built
     double ms = 0.0;
     std::exception_ptr failure;  // what it threw
+    sim::WorkerThread builder{"dp-rain-build"};
   };
-  std::optional<Building> building_;
-  sim::WorkerThread builder_{"dp-rain-build"};
+  static constexpr int kLanes = 2;
+  std::unique_ptr<Lane> lanes_[kLanes];
+  int next_lane_ = 0;
+  Lane* lane_of(const FrameContext& frame) const;
 };
 
 // RAIN view: the rain layer alone over black. The scene's passes before it leave their depth, so
