@@ -99,7 +99,8 @@ TEST_F(RendererTest, DryWindshieldViewIsTheOutlineOnBlack) {
 
 // A tick's views begun together and then ended (as the scheduler draws them, so that they
 // overlap) give the pixels that rendering them one at a time gives, by day and at night (where
-// each view's lamps, and the lamp map under the glass's environment, are its own again).
+// each view's lamps, and the lamp map under the glass's environment, are its own again), whether
+// a view's rain pass came in begin() or was left to end().
 TEST_F(RendererTest, ViewsBegunTogetherDrawAsOneAtATime) {
   sim::SceneState day = highway_scene();
   sim::SceneState night = day;
@@ -107,8 +108,10 @@ TEST_F(RendererTest, ViewsBegunTogetherDrawAsOneAtATime) {
   night.weather.cloudiness = 0.0;
   night.weather.fog_density = 0.0;
   night.ego_lights.headlights = sim::Headlights::kLow;
-  const std::array<sim::ViewSpec, 2> specs = {view_spec(sim::View::kCockpit, kWidth, kHeight),
-                                              view_spec(sim::View::kRoad, kWidth, kHeight)};
+  // Three, each with rain: each view's rain layer is built in a lane of its own.
+  const std::array<sim::ViewSpec, 3> specs = {view_spec(sim::View::kCockpit, kWidth, kHeight),
+                                              view_spec(sim::View::kRoad, kWidth, kHeight),
+                                              view_spec(sim::View::kRain, kWidth, kHeight)};
   for (const sim::SceneState* scene : {&day, &night}) {
     const StepSource stepped = [scene]() -> const sim::SceneState& { return *scene; };
     auto pixels = [&](const PendingReadback& pending) {
@@ -117,14 +120,14 @@ TEST_F(RendererTest, ViewsBegunTogetherDrawAsOneAtATime) {
       return out;
     };
     const std::unique_ptr<RenderSession> alone = renderer().open_session();
-    std::array<std::vector<std::uint8_t>, 2> one_at_a_time;
-    for (int v = 0; v < 2; ++v)
+    std::array<std::vector<std::uint8_t>, 3> one_at_a_time;
+    for (int v = 0; v < 3; ++v)
       one_at_a_time[v] = pixels(renderer().render(*alone, v, specs[v], *scene, stepped));
     const std::unique_ptr<RenderSession> together = renderer().open_session();
-    std::array<std::unique_ptr<Renderer::ViewFrame>, 2> begun;
-    for (int v = 0; v < 2; ++v)
+    std::array<std::unique_ptr<Renderer::ViewFrame>, 3> begun;
+    for (int v = 0; v < 3; ++v)
       begun[v] = renderer().begin(*together, v, specs[v], *scene, stepped);
-    for (int v = 0; v < 2; ++v) {
+    for (int v = 0; v < 3; ++v) {
       const std::vector<std::uint8_t> overlapped = pixels(renderer().end(*begun[v]));
       ASSERT_EQ(overlapped.size(), one_at_a_time[v].size());
       EXPECT_TRUE(overlapped == one_at_a_time[v])

@@ -22,7 +22,6 @@ RainPass::RainPass(SharedResources& shared)
       program_("rain.vert", "rain.frag"),
       u_plane_depth_(program_.uniform("u_plane_depth")) {
   vao_ = make_vertex_array();
-  for (auto& lane : lanes_) lane = std::make_unique<Lane>();
 }
 
 bool RainPass::wanted(const FrameContext& frame) const {
@@ -137,10 +136,26 @@ RainPass::Lane* RainPass::lane_of(const FrameContext& frame) const {
 void RainPass::start(const FrameContext& frame) {
   finish_build(frame);
   if (!wanted(frame)) return;
-  // The lane least recently started; a build still in it (a frame that never took it) is dropped.
-  Lane& lane = *lanes_[next_lane_];
-  next_lane_ = (next_lane_ + 1) % kLanes;
-  if (lane.frame) finish_build(*lane.frame);
+  // A free lane, or a new one, up to a lane for each of a session's views; past that (views
+  // begun and never ended) the one least recently started, its build dropped (its frame's rain
+  // pass builds again).
+  Lane* free = nullptr;
+  for (const auto& l : lanes_) {
+    if (!l->frame) {
+      free = l.get();
+      break;
+    }
+  }
+  if (!free && lanes_.size() < kMaxLanes)
+    free = lanes_.emplace_back(std::make_unique<Lane>()).get();
+  if (!free) {
+    free = std::min_element(lanes_.begin(), lanes_.end(), [](const auto& a, const auto& b) {
+             return a->started < b->started;
+           })->get();
+    finish_build(*free->frame);
+  }
+  Lane& lane = *free;
+  lane.started = ++starts_;
   const sim::RainState& rain = frame.rain();
   const int width = (frame.spec.width + kLayerDivisor - 1) / kLayerDivisor;
   const int height = (frame.spec.height + kLayerDivisor - 1) / kLayerDivisor;

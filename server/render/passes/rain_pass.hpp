@@ -111,10 +111,11 @@ class RainPass final : public Pass {
   VertexArray vao_;  // none of its own attributes: rain.vert reads the runs
   Drawn drawn_;
   // A frame's build (start()): its layer and the thread it is built on (its second half on the
-  // layer's own), and what the layer reads, kept until the build is taken. Two, for a tick's two
-  // views.
+  // layer's own), and what the layer reads, kept until the build is taken. One for each view of a
+  // tick whose layer is being built (the demo: two).
   struct Lane {
     const FrameContext* frame = nullptr;  // the frame being built for, or none
+    std::uint64_t started = 0;            // when, in builds started (RainPass::starts_)
     const sim::RainState* rain = nullptr;
     RainLayerInputs in;
     std::vector<RainOccluder> occluders;  // the frame's cars, for the layer
@@ -129,9 +130,9 @@ class RainPass final : public Pass {
     std::exception_ptr failure;  // what it threw
     sim::WorkerThread builder{"dp-rain-build"};
   };
-  static constexpr int kLanes = 2;
-  std::unique_ptr<Lane> lanes_[kLanes];
-  int next_lane_ = 0;
+  static constexpr std::size_t kMaxLanes = sim::kViewCount;
+  std::vector<std::unique_ptr<Lane>> lanes_;  // made as needed
+  std::uint64_t starts_ = 0;                  // builds started
   Lane* lane_of(const FrameContext& frame) const;
 };
 
