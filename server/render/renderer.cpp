@@ -632,8 +632,8 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
   // their order).
   m.passes.rain->take_drawn();
   if (lists(*v.passes, m.passes.rain)) {
-    m.passes.rain->start(frame);
     v.rain_pass = m.passes.rain;
+    m.passes.rain->start(frame);
   }
   while (v.next_pass < v.passes->size()) {
     Pass* pass = (*v.passes)[v.next_pass];
@@ -666,9 +666,10 @@ PendingReadback Renderer::end(ViewFrame& view) {
   m.timings = std::move(v.timings);
   glBindFramebuffer(GL_FRAMEBUFFER, v.resources.view_fbo);
   glViewport(0, 0, spec.width, spec.height);
-  // Passes left to draw (the glass's) after another view began or ended since this one began:
-  // this one's lamps, blocks and sky again; its lamp map only if a face of the environment is
-  // drawn (run_view_pass). A view with none left (ROAD) only starts its readback.
+  // Passes left to draw (the glass's, and the rain's and the spray's where begin() left them)
+  // after another view began or ended since this one began: this one's lamps, blocks and sky
+  // again; its lamp map only if a face of the environment is drawn (run_view_pass). A view with
+  // none left only starts its readback.
   if (v.next_pass < v.passes->size()) {
     if (m.lamps_of != v.begun) m.set_view(v);
     v.lamp_map_stale = lists(m.frame_passes(spec), m.passes.lamp_map) && m.lamp_map_of != v.begun;

@@ -2,9 +2,9 @@
 // needs its result. The scheduler runs the simulation's step on one (the water steps while the
 // scene's passes, which need only the frame's inputs, are drawn; the job is the same code in the
 // same order on whichever thread, so lockstep runs stay bit-exact), and the step itself shares its
-// work with another (`dp-world`: the world outside the glass); the rain layer is built on one
-// (`dp-rain-build`) beside the render thread, sharing its work with a second, and the spray pass
-// shares its with one. Starting a job costs a wake-up, not a thread.
+// work with another (`dp-world`: the world outside the glass); each view's rain layer is built on
+// one (`dp-rain-build`) beside the render thread, sharing its work with a second, and the spray
+// pass shares its with one. Starting a job costs a wake-up, not a thread.
 #pragma once
 
 #include <condition_variable>

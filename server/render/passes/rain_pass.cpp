@@ -139,12 +139,12 @@ void RainPass::start(const FrameContext& frame) {
   // A free lane, or a new one, up to a lane for each of a session's views; past that (views
   // begun and never ended) the one least recently started, its build dropped (its frame's rain
   // pass builds again).
-  Lane* free = nullptr;
+  const int width = (frame.spec.width + kLayerDivisor - 1) / kLayerDivisor;
+  const int height = (frame.spec.height + kLayerDivisor - 1) / kLayerDivisor;
+  Lane* free = nullptr;  // one whose layer has the size first: another size clears all of it
   for (const auto& l : lanes_) {
-    if (!l->frame) {
+    if (!l->frame && (!free || (l->layer.width() == width && l->layer.height() == height)))
       free = l.get();
-      break;
-    }
   }
   if (!free && lanes_.size() < kMaxLanes)
     free = lanes_.emplace_back(std::make_unique<Lane>()).get();
@@ -157,8 +157,6 @@ void RainPass::start(const FrameContext& frame) {
   Lane& lane = *free;
   lane.started = ++starts_;
   const sim::RainState& rain = frame.rain();
-  const int width = (frame.spec.width + kLayerDivisor - 1) / kLayerDivisor;
-  const int height = (frame.spec.height + kLayerDivisor - 1) / kLayerDivisor;
   RainLayerInputs in = rain_layer_inputs(frame, height, lane.occluders, lane.lamps);
   if (frame.spec.background == sim::Background::kClient) {
     // Hidden by what the picture shows nearer; no cabin of ours. A picture's own depth is taken
@@ -179,7 +177,6 @@ void RainPass::start(const FrameContext& frame) {
     lane.cabin_tiles.assign(tiles.begin(), tiles.end());
     in.cabin_tiles = lane.cabin_tiles;
   }
-  lane.frame = &frame;
   lane.rain = &rain;
   lane.in = in;
   lane.built.store(false, std::memory_order_relaxed);
@@ -195,6 +192,7 @@ void RainPass::start(const FrameContext& frame) {
     }
     lane.built.store(true, std::memory_order_release);
   });
+  lane.frame = &frame;  // once started (a start that throws leaves the lane free)
 }
 
 bool RainPass::built(const FrameContext& frame) const {

@@ -45,9 +45,9 @@ class RainPass final : public Pass {
   void execute(const FrameContext& frame, const FrameResources& resources) override;
   // Starts building the frame's layer (its CPU work, some milliseconds) on threads of the pass's
   // own, so that it runs while the render thread draws the passes before the rain; execute()
-  // takes it. Two frames' layers may be built at once (a tick's two views). Nothing where the
-  // frame has no rain. The frame's rain state must outlive the build: a frame that ends before
-  // its rain pass (a throw) calls finish_build().
+  // takes it. Each view of a tick may have a layer being built at once. Nothing where the frame
+  // has no rain. The frame's rain state must outlive the build: a frame that ends before its rain
+  // pass (a throw) calls finish_build() (the renderer's view frame does, as it is destroyed).
   void start(const FrameContext& frame);
   // Whether the frame's layer is built (or none was started for it).
   bool built(const FrameContext& frame) const;
