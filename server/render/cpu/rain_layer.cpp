@@ -183,61 +183,56 @@ void RainLayer::Frame::project(Batch& b, int n) const {
 }
 
 void RainLayer::Frame::project_copy(Batch& b, int n, int c) const {
-  {
-    const glm::vec3 offset = copies[c].offset_v;
-    const float behind = copies[c].behind ? 1.0f : 0.0f;
-    for (int i = 0; i < n; ++i) {
-      const float hvx = b.head_x[i] + offset.x, hvy = b.head_y[i] + offset.y;
-      const float depth = -(b.head_z[i] + offset.z);
-      const float reach = b.reach[i];
-      // Drops nearer than kNearestM are not drawn (any eye or camera focused on the road sees
-      // them as a faint blur). Most copies lie wholly outside the view: a streak whose head is
-      // further out of the view than the streak reaches cannot come into it.
-      // (& and |, not && and ||: no branches, so that the loop is vector code.)
-      bool visible = (depth >= kNearestM) & (std::abs(hvx) - reach <= tan_x * (depth + reach)) &
-                     (std::abs(hvy) - reach <= tan_y * (depth + reach));
-      float tvx = hvx - b.motion_x[i], tvy = hvy - b.motion_y[i];
-      float tail_depth = depth + b.motion_z[i];
-      // A tail behind the camera: cut where the streak comes within 6 cm of it.
-      const bool cut = tail_depth < 0.06f;
-      const float t = cut ? (depth - 0.06f) / std::max(depth - tail_depth, 1e-6f) : 1.0f;
-      tvx = hvx + (tvx - hvx) * t;
-      tvy = hvy + (tvy - hvy) * t;
-      tail_depth = cut ? 0.06f : tail_depth;
-      const float inv_depth = 1.0f / std::max(depth, kNearestM);
-      const float inv_tail = 1.0f / std::max(tail_depth, 0.06f);
-      const float hx = cx + sx * hvx * inv_depth, hy = cy + sy * hvy * inv_depth;
-      const float tx = cx + sx * tvx * inv_tail, ty = cy + sy * tvy * inv_tail;
-      visible = visible & !(((hx < 0.0f) & (tx < 0.0f)) | ((hy < 0.0f) & (ty < 0.0f)) |
-                            ((hx >= width) & (tx >= width)) | ((hy >= height) & (ty >= height)));
-      // Widths and lengths in the view's pixels, for the same opacity at any layer size.
-      const float true_width = b.diameter[i] * 1e-3f * sy * inv_depth * px;
-      const float half_width = 0.5f * std::max(true_width, 1.0f) + 0.5f;
-      const float core = std::clamp(true_width / (2.0f * half_width), 0.0f, 1.0f);
-      const float length = std::max(std::abs(tx - hx), std::abs(ty - hy));
-      const float spread = std::clamp(2.0f * half_width / std::max(length * px, 1.0f), 0.3f, 1.0f);
-      // Haze (seed 004): far streaks fade in steps of opacity, 3/4, 1/2 and 1/4, by distance.
-      const float level = depth < 5.0f    ? 1.0f
-                          : depth < 10.0f ? 0.75f
-                          : depth < 16.0f ? 0.5f
-                                          : 0.25f;
-      const float fade = std::max(behind, b.far_fade[i]) * b.top_fade[i];
-      const float alpha = opacity * level * fade * (0.35f + 0.65f * core) * spread;
-      b.hx[i] = hx, b.hy[i] = hy;
-      b.depth[i] = depth;
-      b.alpha[i] = visible ? alpha : 0.0f;
-      b.width[i] = true_width;
-      // The Wu line's set-up (draw_streak): along the major axis from its lower end.
-      const bool x_major = std::abs(tx - hx) >= std::abs(ty - hy);
-      const float a_head = x_major ? hx : hy, a_tail = x_major ? tx : ty;
-      const float b_head = x_major ? hy : hx, b_tail = x_major ? ty : tx;
-      const bool swap = a_tail < a_head;
-      const float a0 = swap ? a_tail : a_head, a1 = swap ? a_head : a_tail;
-      const float b0 = swap ? b_tail : b_head, b1 = swap ? b_head : b_tail;
-      b.a0[i] = a0, b.a1[i] = a1, b.b0[i] = b0, b.b1[i] = b1;
-      b.slope[i] = a1 - a0 > 1e-6f ? (b1 - b0) / std::max(a1 - a0, 1e-6f) : 0.0f;
-      b.x_major[i] = x_major ? 1 : 0;
-    }
+  const glm::vec3 offset = copies[c].offset_v;
+  const float behind = copies[c].behind ? 1.0f : 0.0f;
+  for (int i = 0; i < n; ++i) {
+    const float hvx = b.head_x[i] + offset.x, hvy = b.head_y[i] + offset.y;
+    const float depth = -(b.head_z[i] + offset.z);
+    const float reach = b.reach[i];
+    // Drops nearer than kNearestM are not drawn (any eye or camera focused on the road sees
+    // them as a faint blur). Most copies lie wholly outside the view: a streak whose head is
+    // further out of the view than the streak reaches cannot come into it.
+    // (& and |, not && and ||: no branches, so that the loop is vector code.)
+    bool visible = (depth >= kNearestM) & (std::abs(hvx) - reach <= tan_x * (depth + reach)) &
+                   (std::abs(hvy) - reach <= tan_y * (depth + reach));
+    float tvx = hvx - b.motion_x[i], tvy = hvy - b.motion_y[i];
+    float tail_depth = depth + b.motion_z[i];
+    // A tail behind the camera: cut where the streak comes within 6 cm of it.
+    const bool cut = tail_depth < 0.06f;
+    const float t = cut ? (depth - 0.06f) / std::max(depth - tail_depth, 1e-6f) : 1.0f;
+    tvx = hvx + (tvx - hvx) * t;
+    tvy = hvy + (tvy - hvy) * t;
+    tail_depth = cut ? 0.06f : tail_depth;
+    const float inv_depth = 1.0f / std::max(depth, kNearestM);
+    const float inv_tail = 1.0f / std::max(tail_depth, 0.06f);
+    const float hx = cx + sx * hvx * inv_depth, hy = cy + sy * hvy * inv_depth;
+    const float tx = cx + sx * tvx * inv_tail, ty = cy + sy * tvy * inv_tail;
+    visible = visible & !(((hx < 0.0f) & (tx < 0.0f)) | ((hy < 0.0f) & (ty < 0.0f)) |
+                          ((hx >= width) & (tx >= width)) | ((hy >= height) & (ty >= height)));
+    // Widths and lengths in the view's pixels, for the same opacity at any layer size.
+    const float true_width = b.diameter[i] * 1e-3f * sy * inv_depth * px;
+    const float half_width = 0.5f * std::max(true_width, 1.0f) + 0.5f;
+    const float core = std::clamp(true_width / (2.0f * half_width), 0.0f, 1.0f);
+    const float length = std::max(std::abs(tx - hx), std::abs(ty - hy));
+    const float spread = std::clamp(2.0f * half_width / std::max(length * px, 1.0f), 0.3f, 1.0f);
+    // Haze (seed 004): far streaks fade in steps of opacity, 3/4, 1/2 and 1/4, by distance.
+    const float level = depth < 5.0f ? 1.0f : depth < 10.0f ? 0.75f : depth < 16.0f ? 0.5f : 0.25f;
+    const float fade = std::max(behind, b.far_fade[i]) * b.top_fade[i];
+    const float alpha = opacity * level * fade * (0.35f + 0.65f * core) * spread;
+    b.hx[i] = hx, b.hy[i] = hy;
+    b.depth[i] = depth;
+    b.alpha[i] = visible ? alpha : 0.0f;
+    b.width[i] = true_width;
+    // The Wu line's set-up (draw_streak): along the major axis from its lower end.
+    const bool x_major = std::abs(tx - hx) >= std::abs(ty - hy);
+    const float a_head = x_major ? hx : hy, a_tail = x_major ? tx : ty;
+    const float b_head = x_major ? hy : hx, b_tail = x_major ? ty : tx;
+    const bool swap = a_tail < a_head;
+    const float a0 = swap ? a_tail : a_head, a1 = swap ? a_head : a_tail;
+    const float b0 = swap ? b_tail : b_head, b1 = swap ? b_head : b_tail;
+    b.a0[i] = a0, b.a1[i] = a1, b.b0[i] = b0, b.b1[i] = b1;
+    b.slope[i] = a1 - a0 > 1e-6f ? (b1 - b0) / std::max(a1 - a0, 1e-6f) : 0.0f;
+    b.x_major[i] = x_major ? 1 : 0;
   }
 }
 
@@ -338,9 +333,9 @@ std::uint32_t RainLayer::build(const sim::RainState& rain, const RainLayerInputs
 
 std::uint32_t RainLayer::draw(const Frame& f, std::size_t begin, std::size_t end, Texels& out,
                               Bounds& dirty, Batch& bt) const {
-  // Each thread works through its drops in batches, in two phases: first every copy of every drop
-  // of the batch as vector code (Frame::project); then the streaks that came out visible, one by
-  // one, as Wu lines.
+  // Each thread works through its drops in batches: every drop of the batch as vector code
+  // (Frame::project), then for each copy of the box, its copies of them as vector code as well
+  // (Frame::project_copy) and the streaks that came out visible, one by one, as Wu lines.
   const SpeedTable& speeds = speed_table();
   std::uint32_t drawn = 0;
   Bounds touched{width_, height_, 0, 0};
