@@ -3,7 +3,6 @@
 #include <atomic>
 #include <exception>
 #include <memory>
-#include <optional>
 #include <utility>
 #include <vector>
 
