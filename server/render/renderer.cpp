@@ -557,7 +557,7 @@ PendingReadback Renderer::render(RenderSession& session, int view_index, const s
 std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int view_index,
                                                      const sim::ViewSpec& spec,
                                                      const sim::SceneState& scene,
-                                                     const StepSource& stepped) {
+                                                     const StepSource& stepped, bool rain_ahead) {
   Impl& m = *impl_;
   RenderSession::Impl& s = *session.impl_;
   m.timings.clear();
@@ -626,12 +626,12 @@ std::unique_ptr<Renderer::ViewFrame> Renderer::begin(RenderSession& session, int
     m.timed(pass->decl().name, [&] { m.run_pass(*pass, frame, s, resources); });
   if (lists(frame_passes, m.passes.lamp_map)) m.lamp_map_of = v.begun;
   // The passes that need only the frame's inputs: those before the first that reads the step.
-  // The rain's layer is built meanwhile, on the CPU, on threads of its own.
-  // Where the layer is not built yet when its pass comes, that pass and those after it wait for
-  // end(), so that this thread draws the next view's passes meanwhile (each view's passes keep
-  // their order).
+  // With rain_ahead the rain's layer is built meanwhile, on the CPU, on threads of its own. Where
+  // the layer is not built yet when its pass comes, that pass and those after it wait for end(),
+  // so that this thread draws the next view's passes meanwhile (each view's passes keep their
+  // order).
   m.passes.rain->take_drawn();
-  if (lists(*v.passes, m.passes.rain)) {
+  if (rain_ahead && lists(*v.passes, m.passes.rain)) {
     v.rain_pass = m.passes.rain;
     m.passes.rain->start(frame);
   }

@@ -143,7 +143,12 @@ class Renderer {
   // rest and starts the readback. Between them other views may begin or end; each
   // view begun is ended once, or dropped (then its frame is lost, and its target kept). `session`,
   // `spec`, `scene` and `stepped` must live until end(). (A session's first frame waits for the
-  // step in begin(): no rain has been published before it.)
+  // step in begin(): no rain has been published before it.) With `rain_ahead` (a tick of two views
+  // or more), the view's rain layer is built beside its world's passes, and where it is not built
+  // when the rain pass comes, the rain pass and those after it are left to end(), for the render
+  // thread to begin the next view meanwhile. A view alone builds it when its pass comes: measured
+  // at 1280x720, building it ahead slowed the view's own frame (its threads took the cores from the
+  // world's passes, with nothing else to draw meanwhile).
   class ViewFrame {
    public:
     ~ViewFrame();
@@ -158,7 +163,7 @@ class Renderer {
   };
   std::unique_ptr<ViewFrame> begin(RenderSession& session, int view_index,
                                    const sim::ViewSpec& spec, const sim::SceneState& scene,
-                                   const StepSource& stepped);
+                                   const StepSource& stepped, bool rain_ahead = false);
   PendingReadback end(ViewFrame& view);
   // The same with the scene's own windshield and rain.
   PendingReadback render(RenderSession& session, int view_index, const sim::ViewSpec& spec,

@@ -410,7 +410,8 @@ void FrameScheduler::tick(const std::shared_ptr<Session>& s, const StartedStep& 
     std::vector<double> begin_ms;
     for (std::size_t i = 0; i < views.size(); ++i) {
       const Clock::time_point t0 = Clock::now();
-      begun.push_back(renderer_->begin(*targets, static_cast<int>(i), views[i], inputs, water));
+      begun.push_back(renderer_->begin(*targets, static_cast<int>(i), views[i], inputs, water,
+                                       views.size() > 1));
       begin_ms.push_back(ms_since(t0));
     }
     for (std::size_t i = 0; i < views.size(); ++i) {

@@ -126,7 +126,7 @@ TEST_F(RendererTest, ViewsBegunTogetherDrawAsOneAtATime) {
     const std::unique_ptr<RenderSession> together = renderer().open_session();
     std::array<std::unique_ptr<Renderer::ViewFrame>, 3> begun;
     for (int v = 0; v < 3; ++v)
-      begun[v] = renderer().begin(*together, v, specs[v], *scene, stepped);
+      begun[v] = renderer().begin(*together, v, specs[v], *scene, stepped, true);
     for (int v = 0; v < 3; ++v) {
       const std::vector<std::uint8_t> overlapped = pixels(renderer().end(*begun[v]));
       ASSERT_EQ(overlapped.size(), one_at_a_time[v].size());
