@@ -208,9 +208,12 @@ void RainPass::finish_build(const FrameContext& frame) {
 }
 
 void RainPass::execute(const FrameContext& frame, const FrameResources&) {
-  if (!lane_of(frame)) start(frame);  // (a pass run alone, as the tests do)
   Lane* lane = lane_of(frame);
-  if (!lane) return;  // no rain after all
+  if (!lane) {  // not built ahead (a view alone, or a pass run alone, as the tests do)
+    start(frame);
+    lane = lane_of(frame);
+    if (!lane) return;  // no rain after all
+  }
   // The passes drawn so far go to llvmpipe's rasterizer threads now, rather than wait in its bins
   // while the layer is finished: the cores share the two.
   glFlush();
