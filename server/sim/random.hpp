@@ -36,12 +36,15 @@ class RandomStream {
     return total;
   }
 
- private:
-  static std::uint64_t mix(std::uint64_t z) {  // splitmix64's finaliser
+  // splitmix64's finaliser: a number scrambled, every bit of it on every bit of the result (a
+  // stream's state; also a number of its own for each of a set of things, from its index).
+  static std::uint64_t mix(std::uint64_t z) {
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
     return z ^ (z >> 31);
   }
+
+ private:
   std::uint64_t state_;
 };
 

@@ -15,6 +15,7 @@
 #include "server/render/cpu/cabin_tiles.hpp"
 #include "server/render/cpu/display.hpp"
 #include "server/render/cpu/light_set.hpp"
+#include "server/sim/random.hpp"
 
 namespace downpour::render {
 
@@ -67,6 +68,7 @@ const CoverageTable& coverage_table() {
 struct RainLayer::Batch {
   float x[kBatch], y[kBatch], z[kBatch], diameter[kBatch], speed[kBatch];
   float far_fade[kBatch], top_fade[kBatch];
+  std::int32_t pick[kBatch];  // the drop's own number, 24 bits, the same every frame (thinning)
   float head_x[kBatch], head_y[kBatch], head_z[kBatch];
   float motion_x[kBatch], motion_y[kBatch], motion_z[kBatch], reach[kBatch];
   // The copy being drawn, per drop: its streak's head on the layer, its depth, opacity (0 where
@@ -106,6 +108,8 @@ struct RainLayer::Frame {
   float tan_x, tan_y, sx, sy, cx, cy;
   int max_steps;
   float px, opacity;
+  // The share of far streaks drawn, and how fast the share falls to it from kThinFromM (per m).
+  float far_share, thin_slope;
   // The box repeats across and along: its drops are drawn again one box width to each side, so
   // that the rain fills the view to its edges where the view is wider than the box (far ahead) and
   // the box's sides leave no seam; and, for a camera behind the box (the chase camera), one box
@@ -148,6 +152,8 @@ RainLayer::Frame::Frame(const sim::RainState& rain, const RainLayerInputs& in, i
   max_steps = 2 * (width + height);
   px = in.pixels_per_texel;
   opacity = in.opacity;
+  far_share = std::clamp(in.far_share, 0.05f, 1.0f);
+  thin_slope = (1.0f - far_share) / (RainLayerInputs::kThinToM - RainLayerInputs::kThinFromM);
   const glm::vec3 across = rotate * (rain.box_left * (2.0f * rain.box_half_m.y));
   const glm::vec3 back = rotate * (rain.box_forward * (-2.0f * rain.box_half_m.x));
   copies[0] = {glm::vec3(0.0f), false};
@@ -218,10 +224,17 @@ void RainLayer::Frame::project_copy(Batch& b, int n, int c) const {
     // Haze (seed 004): far streaks fade in steps of opacity, 3/4, 1/2 and 1/4, by distance.
     const float level = depth < 5.0f ? 1.0f : depth < 10.0f ? 0.75f : depth < 16.0f ? 0.5f : 0.25f;
     const float fade = std::max(behind, b.far_fade[i]) * b.top_fade[i];
-    const float alpha = opacity * level * fade * (0.35f + 0.65f * core) * spread;
+    // Far streaks thinned (RainLayerInputs::far_share): each copy of a drop by a number of its
+    // own (the drop's, moved on by the golden ratio for each copy).
+    const float keep =
+        std::clamp(1.0f - (depth - RainLayerInputs::kThinFromM) * thin_slope, far_share, 1.0f);
+    const float pick =
+        static_cast<float>((b.pick[i] + c * 10368890) & 0xffffff) * (1.0f / 16777216.0f);
+    const bool kept = pick < keep;
+    const float alpha = opacity * level * fade * (0.35f + 0.65f * core) * spread / keep;
     b.hx[i] = hx, b.hy[i] = hy;
     b.depth[i] = depth;
-    b.alpha[i] = visible ? alpha : 0.0f;
+    b.alpha[i] = visible & kept ? alpha : 0.0f;
     b.width[i] = true_width;
     // The Wu line's set-up (draw_streak): along the major axis from its lower end.
     const bool x_major = std::abs(tx - hx) >= std::abs(ty - hy);
@@ -345,6 +358,9 @@ std::uint32_t RainLayer::draw(const Frame& f, std::size_t begin, std::size_t end
       const glm::vec4& drop = f.rain.drops[first_drop + i];
       bt.x[i] = drop.x, bt.y[i] = drop.y, bt.z[i] = drop.z, bt.diameter[i] = drop.w;
       bt.speed[i] = speeds.at(drop.w);
+      // The drop's number for the thinning, from its place in the field, which it keeps while it
+      // falls (one born again in its place draws another lot).
+      bt.pick[i] = static_cast<std::int32_t>(sim::RandomStream::mix(first_drop + i) >> 40);
     }
     f.project(bt, n);
     for (int c = 0; c < f.copy_count; ++c) {

@@ -2,7 +2,8 @@
 // it, on the texels inside its outline; the composite's runs of tiles cover every texel with rain
 // and, for rain in one part of the view, little else; the cabin's tiles are left out or put apart;
 // a lamp's light leaves nothing for the next frame; long streaks at every slope, up to the view's
-// edges, stay in the layer.
+// edges, stay in the layer; far streaks are thinned, to the same opacity and the same drops in
+// every frame.
 #include "server/render/cpu/rain_layer.hpp"
 
 #include "server/render/cpu/cabin_tiles.hpp"
@@ -116,7 +117,7 @@ TEST(RainLayerTest, LongStreaksAtEverySlopeStayInTheLayer) {
   rain.fall_direction = glm::normalize(glm::vec3(0.2f, 0.5f, -1.0f));
   rain.wind_mps = glm::vec3(0.0f, -6.0f, 0.0f);
   RainLayer layer;
-  EXPECT_GT(layer.build(rain, in, kWidth, kHeight), 3000u);
+  EXPECT_GT(layer.build(rain, in, kWidth, kHeight), 2500u);  // of 4,000 (the far ones thinned)
   int corners[4] = {};
   for (int y = 0; y < kHeight; ++y) {
     for (int x = 0; x < kWidth; ++x) {
@@ -125,6 +126,59 @@ TEST(RainLayerTest, LongStreaksAtEverySlopeStayInTheLayer) {
     }
   }
   for (int q = 0; q < 4; ++q) EXPECT_GT(corners[q], kWidth * kHeight / 16) << "quarter " << q;
+}
+
+// Drops scattered over the view from 25 to 30 m ahead, where the far streaks are thinned.
+std::vector<glm::vec3> far_off() {
+  std::vector<glm::vec3> out;
+  for (int i = 0; i < 3000; ++i) {
+    const float x = 25.0f + 5.0f * static_cast<float>(i % 101) / 100.0f;
+    const float across = (static_cast<float>(i % 67) / 33.0f - 1.0f) * 0.95f * x;
+    const float up = (static_cast<float>(i % 43) / 21.0f - 1.0f) * 0.28f * x;  // under the top
+    out.emplace_back(x, across, up);
+  }
+  return out;
+}
+
+std::uint64_t opacity_sum(const RainLayer& layer) {
+  std::uint64_t sum = 0;
+  for (const std::uint32_t c : layer.colour()) sum += c >> 24;
+  return sum;
+}
+
+TEST(RainLayerTest, FarStreaksAreThinnedToTheSameOpacityOnAverage) {
+  static_assert(RainLayerInputs::kThinToM <= 25.0f, "the drops lie where the share is far_share");
+  const sim::RainState rain = rain_at(far_off());
+  RainLayerInputs all = inputs(), thinned = inputs();
+  all.far_share = 1.0f;
+  ASSERT_LT(thinned.far_share, 0.75f) << "the default thins them";
+  RainLayer every, fewer;
+  const std::uint32_t drawn_all = every.build(rain, all, kWidth, kHeight);
+  const std::uint32_t drawn = fewer.build(rain, thinned, kWidth, kHeight);
+  EXPECT_GT(drawn_all, 2900u) << "nearly all in view";
+  EXPECT_NEAR(drawn, thinned.far_share * drawn_all, 0.05 * drawn_all);
+  // Each streak drawn the more opaque: the layer as opaque as before, summed over its texels.
+  const double ratio =
+      static_cast<double>(opacity_sum(fewer)) / static_cast<double>(opacity_sum(every));
+  EXPECT_NEAR(ratio, 1.0, 0.06);
+}
+
+TEST(RainLayerTest, TheSameFarDropsAreDrawnFromFrameToFrame) {
+  // A millisecond on, the drops have moved by a hundredth of a texel: the layer must be nearly the
+  // same, not another half of them drawn (which would flicker).
+  const sim::RainState rain = rain_at(far_off());
+  RainLayerInputs now = inputs(), later = inputs();
+  later.dt_s = 0.001;
+  RainLayer a, b;
+  a.build(rain, now, kWidth, kHeight);
+  b.build(rain, later, kWidth, kHeight);
+  std::uint64_t changed = 0;
+  for (std::size_t k = 0; k < a.colour().size(); ++k) {
+    const int da = static_cast<int>(a.colour()[k] >> 24),
+              db = static_cast<int>(b.colour()[k] >> 24);
+    changed += static_cast<std::uint64_t>(std::abs(da - db));
+  }
+  EXPECT_LT(static_cast<double>(changed), 0.05 * static_cast<double>(opacity_sum(a)));
 }
 
 TEST(RainLayerTest, TheRunsCoverEveryTexelWithRainAndLittleElse) {
