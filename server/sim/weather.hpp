@@ -36,7 +36,7 @@ enum class Interpolation { kLinear, kAngle, kRound };
     "the sun's height over the horizon")                                                  \
   X(sun_azimuth_deg, double, "deg", -360.0, 360.0, 135.0, kAngle, "world yaw of the sun") \
   X(rain_streak_count, std::uint32_t, "", 0.0, 80000.0, 0.0, kRound,                      \
-    "streaks drawn; 0 = from the rain rate (Marshall-Palmer)")                            \
+    "drops around the car, drawn as streaks; 0 = from the rain rate (Marshall-Palmer)")   \
   X(rain_angle_deg, double, "deg", -70.0, 70.0, 0.0, kLinear, "fall angle from vertical")
 
 struct Weather {

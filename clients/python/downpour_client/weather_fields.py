@@ -29,7 +29,7 @@ FIELDS = (
      "meaning": "world yaw of the sun"},
     {"name": "rain_streak_count", "unit": "", "min": 0.0, "max": 80000.0, "default": 0.0,
      "interpolation": "round", "integer": True,
-     "meaning": "streaks drawn; 0 = from the rain rate (Marshall-Palmer)"},
+     "meaning": "drops around the car, drawn as streaks; 0 = from the rain rate (Marshall-Palmer)"},
     {"name": "rain_angle_deg", "unit": "deg", "min": -70.0, "max": 70.0, "default": 0.0,
      "interpolation": "linear", "integer": False,
      "meaning": "fall angle from vertical"},

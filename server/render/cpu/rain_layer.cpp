@@ -68,7 +68,7 @@ const CoverageTable& coverage_table() {
 struct RainLayer::Batch {
   float x[kBatch], y[kBatch], z[kBatch], diameter[kBatch], speed[kBatch];
   float far_fade[kBatch], top_fade[kBatch];
-  std::int32_t pick[kBatch];  // the drop's own number, 24 bits, the same every frame (thinning)
+  std::int32_t pick[kBatch];  // the drop's own number in 24 bits, the same every frame (thinning)
   float head_x[kBatch], head_y[kBatch], head_z[kBatch];
   float motion_x[kBatch], motion_y[kBatch], motion_z[kBatch], reach[kBatch];
   // The copy being drawn, per drop: its streak's head on the layer, its depth, opacity (0 where
@@ -82,6 +82,11 @@ struct RainLayer::Batch {
 
 // The haze's transmittance by distance, in a table per build (0-64 m, this view's haze).
 constexpr int kHazeSteps = 256;
+// The far streaks' thinning (project_copy): the span of the drops' numbers over which a streak
+// fades in, and the least share drawn (fewer, each the more opaque, and where they overlap the
+// coverage, 1 - exp(-sum), falls short of the mean: 3% at a half, 11% at a tenth).
+constexpr float kThinFade = 0.125f;
+constexpr float kLeastFarShare = 0.25f;
 constexpr float kHazeStepM = 64.0f / kHazeSteps;
 constexpr std::uint32_t kHazeStepCm = 25;  // kHazeStepM
 static_assert(kHazeStepCm == static_cast<std::uint32_t>(kHazeStepM * 100.0f));
@@ -110,6 +115,7 @@ struct RainLayer::Frame {
   float px, opacity;
   // The share of far streaks drawn, and how fast the share falls to it from kThinFromM (per m).
   float far_share, thin_slope;
+  static_assert(RainLayerInputs::kThinToM > RainLayerInputs::kThinFromM);
   // The box repeats across and along: its drops are drawn again one box width to each side, so
   // that the rain fills the view to its edges where the view is wider than the box (far ahead) and
   // the box's sides leave no seam; and, for a camera behind the box (the chase camera), one box
@@ -152,7 +158,7 @@ RainLayer::Frame::Frame(const sim::RainState& rain, const RainLayerInputs& in, i
   max_steps = 2 * (width + height);
   px = in.pixels_per_texel;
   opacity = in.opacity;
-  far_share = std::clamp(in.far_share, 0.05f, 1.0f);
+  far_share = std::clamp(in.far_share, kLeastFarShare, 1.0f);
   thin_slope = (1.0f - far_share) / (RainLayerInputs::kThinToM - RainLayerInputs::kThinFromM);
   const glm::vec3 across = rotate * (rain.box_left * (2.0f * rain.box_half_m.y));
   const glm::vec3 back = rotate * (rain.box_forward * (-2.0f * rain.box_half_m.x));
@@ -191,6 +197,9 @@ void RainLayer::Frame::project(Batch& b, int n) const {
 void RainLayer::Frame::project_copy(Batch& b, int n, int c) const {
   const glm::vec3 offset = copies[c].offset_v;
   const float behind = copies[c].behind ? 1.0f : 0.0f;
+  // (Copies: std::clamp takes its bounds by reference, and a member's would make the compiler
+  // check at run time whether the stores below write it, and keep a scalar loop for that.)
+  const float floor_share = far_share, share_slope = thin_slope;
   for (int i = 0; i < n; ++i) {
     const float hvx = b.head_x[i] + offset.x, hvy = b.head_y[i] + offset.y;
     const float depth = -(b.head_z[i] + offset.z);
@@ -224,17 +233,23 @@ void RainLayer::Frame::project_copy(Batch& b, int n, int c) const {
     // Haze (seed 004): far streaks fade in steps of opacity, 3/4, 1/2 and 1/4, by distance.
     const float level = depth < 5.0f ? 1.0f : depth < 10.0f ? 0.75f : depth < 16.0f ? 0.5f : 0.25f;
     const float fade = std::max(behind, b.far_fade[i]) * b.top_fade[i];
-    // Far streaks thinned (RainLayerInputs::far_share): each copy of a drop by a number of its
-    // own (the drop's, moved on by the golden ratio for each copy).
-    const float keep =
-        std::clamp(1.0f - (depth - RainLayerInputs::kThinFromM) * thin_slope, far_share, 1.0f);
-    const float pick =
-        static_cast<float>((b.pick[i] + c * 10368890) & 0xffffff) * (1.0f / 16777216.0f);
-    const bool kept = pick < keep;
-    const float alpha = opacity * level * fade * (0.35f + 0.65f * core) * spread / keep;
+    // Far streaks thinned (RainLayerInputs::far_share): the share drawn at this depth, and this
+    // drop's weight by its number, w(pick) = clamp((k - pick) / kThinFade, 0, 1), with k such
+    // that w's mean over numbers in [0, 1) is the share; so a streak fades in over kThinFade of
+    // the numbers as the camera nears it rather than appears at once. (k = share + fade / 2 where
+    // the weight's ramp lies within [0, 1); nearer 1, where it passes 1, the root; 1 + fade for
+    // the share 1: every weight 1.)
+    const float share =
+        std::clamp(1.0f - (depth - RainLayerInputs::kThinFromM) * share_slope, floor_share, 1.0f);
+    const float k = share <= 1.0f - 0.5f * kThinFade
+                        ? share + 0.5f * kThinFade
+                        : 1.0f + kThinFade - std::sqrt(2.0f * kThinFade * (1.0f - share));
+    const float pick = static_cast<float>(b.pick[i]) * (1.0f / 16777216.0f);
+    const float weight = std::clamp((k - pick) * (1.0f / kThinFade), 0.0f, 1.0f);
+    const float alpha = opacity * level * fade * (0.35f + 0.65f * core) * spread * weight / share;
     b.hx[i] = hx, b.hy[i] = hy;
     b.depth[i] = depth;
-    b.alpha[i] = visible & kept ? alpha : 0.0f;
+    b.alpha[i] = visible ? alpha : 0.0f;
     b.width[i] = true_width;
     // The Wu line's set-up (draw_streak): along the major axis from its lower end.
     const bool x_major = std::abs(tx - hx) >= std::abs(ty - hy);
@@ -358,8 +373,9 @@ std::uint32_t RainLayer::draw(const Frame& f, std::size_t begin, std::size_t end
       const glm::vec4& drop = f.rain.drops[first_drop + i];
       bt.x[i] = drop.x, bt.y[i] = drop.y, bt.z[i] = drop.z, bt.diameter[i] = drop.w;
       bt.speed[i] = speeds.at(drop.w);
-      // The drop's number for the thinning, from its place in the field, which it keeps while it
-      // falls (one born again in its place draws another lot).
+      // The drop's number for the thinning, from its index in the field, which it keeps while it
+      // falls and when it is born again; the same in every copy of the box, which carry the field
+      // on across its sides (a drop that wraps is drawn the same in the copy it moves into).
       bt.pick[i] = static_cast<std::int32_t>(sim::RandomStream::mix(first_drop + i) >> 40);
     }
     f.project(bt, n);
@@ -465,13 +481,13 @@ void RainLayer::draw_streak(const Frame& f, const Batch& bt, int i, Texels& out,
     const int base = std::clamp(b_fixed >> 16, b_min, b_max);
     const auto frac = static_cast<std::uint32_t>(std::clamp(b_fixed - (base << 16), 0, 1 << 16));
     std::size_t k = m * major_stride + (base - extra) * minor_stride;
-    const std::uint32_t far_share = (whole * frac + (1u << 15)) >> 16;
-    put(k, whole - far_share);
+    const std::uint32_t next_share = (whole * frac + (1u << 15)) >> 16;
+    put(k, whole - next_share);
     for (int e = 1 - extra; e <= extra; ++e) {
       k += minor_stride;
       put(k, whole);
     }
-    put(k + minor_stride, far_share);
+    put(k + minor_stride, next_share);
   }
   b_min -= extra;
   b_max += extra + 2;

@@ -57,12 +57,11 @@ struct RainLayerInputs {
   glm::vec3 lamp_colour{1.0f, 0.96f, 0.88f};
   glm::vec3 up{0.0f, 1.0f, 0.0f};
   float opacity = 0.55f;
-  // The share of the far streaks drawn (1: all). A drop's copy is drawn by a number of its own (the
-  // same every frame, so nothing flickers) with this share from kThinToM on, all of them up to
-  // kThinFromM, and the share in between going down linearly; each streak drawn is the more opaque
-  // by as much, so that the rain's opacity stays the same on average. Far streaks are faint and
-  // many (from the driver's eye, 16 m on: 46% of the streaks for 16% of the opacity), and each
-  // costs its set-up whatever its size.
+  // The share of the far streaks drawn (1: all; at least a quarter): all of them up to
+  // kThinFromM, this share from kThinToM on, linearly between. Each is drawn by a number of the
+  // drop's own, the same every frame, and the more opaque by as much, so that the rain is as
+  // opaque on average (docs/techniques.md: far streaks are faint and many, and each costs its
+  // set-up whatever its size).
   static constexpr float kThinFromM = 10.0f, kThinToM = 20.0f;
   float far_share = 0.5f;
   float pixels_per_texel = 2.0f;     // the view's pixels per layer texel, across
@@ -164,7 +163,8 @@ class RainLayer {
   // Below this many drops one thread draws them all.
   static constexpr std::size_t kDropsForTwoThreads = 4096;
   // What a splash costs to splat, in drops drawn (about 0.16 us against 0.18 from the driver's
-  // eye in heavy rain, downpour-rain-layer-bench): the thread that splats them draws fewer drops.
+  // eye in heavy rain, downpour-rain-layer-bench, before the far streaks were thinned, which took a
+  // drop to about 0.86 of that): the thread that splats them draws fewer drops.
   static constexpr double kDropsPerSplash = 1.0;
   // A batch of drops being projected (rain_layer.cpp).
   struct Batch;
