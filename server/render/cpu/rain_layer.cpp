@@ -82,10 +82,11 @@ struct RainLayer::Batch {
 
 // The haze's transmittance by distance, in a table per build (0-64 m, this view's haze).
 constexpr int kHazeSteps = 256;
-// The far streaks' thinning (project_copy): the span of the drops' numbers over which a streak
-// fades in, and the least share drawn (fewer, each the more opaque, and where they overlap the
-// coverage, 1 - exp(-sum), falls short of the mean: 3% at a half, 11% at a tenth).
+// The far streaks' thinning (project_copy). The span of the drops' numbers over which a streak
+// fades in:
 constexpr float kThinFade = 0.125f;
+// The least share drawn: the fewer, each the more opaque, the more the coverage where they overlap,
+// 1 - exp(-sum), falls short of the mean (3% at a half, 11% at a tenth).
 constexpr float kLeastFarShare = 0.25f;
 constexpr float kHazeStepM = 64.0f / kHazeSteps;
 constexpr std::uint32_t kHazeStepCm = 25;  // kHazeStepM
@@ -236,9 +237,9 @@ void RainLayer::Frame::project_copy(Batch& b, int n, int c) const {
     // Far streaks thinned (RainLayerInputs::far_share): the share drawn at this depth, and this
     // drop's weight by its number, w(pick) = clamp((k - pick) / kThinFade, 0, 1), with k such
     // that w's mean over numbers in [0, 1) is the share; so a streak fades in over kThinFade of
-    // the numbers as the camera nears it rather than appears at once. (k = share + fade / 2 where
-    // the weight's ramp lies within [0, 1); nearer 1, where it passes 1, the root; 1 + fade for
-    // the share 1: every weight 1.)
+    // the numbers as the camera nears it rather than appears at once. Where w's ramp lies within
+    // [0, 1), k = share + kThinFade / 2; where it passes 1 (a share near 1), the root below; at
+    // the share 1, k = 1 + kThinFade: every weight 1.
     const float share =
         std::clamp(1.0f - (depth - RainLayerInputs::kThinFromM) * share_slope, floor_share, 1.0f);
     const float k = share <= 1.0f - 0.5f * kThinFade
