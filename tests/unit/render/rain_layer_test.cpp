@@ -190,11 +190,12 @@ TEST(RainLayerTest, TheSameFarDropsAreDrawnFromFrameToFrame) {
 }
 
 TEST(RainLayerTest, ADropThatWrapsAcrossTheBoxIsDrawnAsBefore) {
-  // The box's side 30 m out to the left of the centre line (its centre 30 m to the left), drops
-  // just inside it; then the same drops wrapped to the box's other side, which the copy of the
-  // box to their right draws where they were. The same streaks must be drawn: a drop's number is
-  // the same in every copy.
-  std::vector<glm::vec3> inside = far_off(5000), wrapped;
+  // The box's centre 30 m to the left, so that its right side lies on the view's centre line, and
+  // drops just inside that side; then the same drops a box's width to the left, past its other
+  // side, where the copy of the box to their right draws them where they were (as it draws a drop
+  // that wrapped across the side). The same streaks must be drawn: a drop's number is the same in
+  // every copy.
+  const std::vector<glm::vec3> inside = far_off(5000);
   sim::RainState before;
   before.origin_m = glm::dvec3(0.0, 30.0, 0.0);
   before.box_half_m = glm::vec3(40.0f, 30.0f, 10.0f);
