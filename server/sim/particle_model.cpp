@@ -232,15 +232,21 @@ void ParticleModel::repel() {
   }
 }
 
-bool ParticleModel::in_region(glm::dvec2 p, const std::array<BladePose, 2>& blades) const {
-  const WaterConfig& w = config_;
+ParticleModel::Regions::Regions(const WaterConfig& w, const std::array<BladePose, 2>& blades) {
   const double margin = w.region_particle_diameters * 2.0 * w.particle_radius_mm;
-  for (const BladePose& b : blades) {
+  for (std::size_t k = 0; k < blades.size(); ++k) {
+    const BladePose& b = blades[k];
     const glm::dvec2 d = blade_direction(b.angle_rad);
-    const glm::dvec2 rel = p - glm::dvec2(b.pivot_mm);
-    const double along = glm::dot(d, rel), across = glm::dot(left_normal(d), rel);
-    if (along >= 0.0 && along <= b.length_mm && std::abs(across) <= 0.5 * b.width_mm + margin)
-      return true;
+    regions_[k] = {glm::dvec2(b.pivot_mm), d, left_normal(d), b.length_mm,
+                   0.5 * b.width_mm + margin};
+  }
+}
+
+bool ParticleModel::Regions::contain(glm::dvec2 p) const {
+  for (const Region& r : regions_) {
+    const glm::dvec2 rel = p - r.pivot;
+    const double along = glm::dot(r.along, rel), across = glm::dot(r.across, rel);
+    if (along >= 0.0 && along <= r.length && std::abs(across) <= r.half_width) return true;
   }
   return false;
 }

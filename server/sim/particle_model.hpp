@@ -26,9 +26,22 @@ class ParticleModel {
   void add(glm::dvec2 pos, double mass) { particles_.push_back({pos, mass, 0.0}); }
   // Pushes overlapping particles apart (a few passes, stopping once none overlap).
   void repel();
-  // Within a blade's region: a rectangle as long as the blade and as wide as the blade plus
-  // region_particle_diameters on each side. A blade of negative length has no region.
-  bool in_region(glm::dvec2 pos, const std::array<BladePose, 2>& blades) const;
+  // The blades' regions: each a rectangle as long as its blade and as wide as the blade plus
+  // region_particle_diameters on each side. A blade of negative length has none. (Their
+  // directions are worked out once, for all of a step's particles.)
+  class Regions {
+   public:
+    Regions(const WaterConfig& config, const std::array<BladePose, 2>& blades);
+    bool contain(glm::dvec2 pos) const;
+
+   private:
+    struct Region {
+      glm::dvec2 pivot, along, across;  // along the blade, and its left normal
+      double length, half_width;
+    };
+    std::array<Region, 2> regions_;
+  };
+  Regions regions(const std::array<BladePose, 2>& blades) const { return {config_, blades}; }
 
   std::vector<Particle>& particles() { return particles_; }
   const std::vector<Particle>& particles() const { return particles_; }

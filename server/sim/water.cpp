@@ -83,6 +83,7 @@ void WaterSim::release_particles(double dt, const WaterInputs& in) {
       any = true;
     }
   }
+  const ParticleModel::Regions regions = particles_.regions(active);
   std::vector<Particle>& particles = particles_.particles();
   std::size_t kept = 0;
   for (std::size_t i = 0; i < particles.size(); ++i) {
@@ -91,7 +92,7 @@ void WaterSim::release_particles(double dt, const WaterInputs& in) {
       released_off_ += p.mass;
       continue;
     }
-    if (any && particles_.in_region(p.pos, active)) {
+    if (any && regions.contain(p.pos)) {
       particles[kept++] = {p.pos, p.mass, 0.0};
       continue;
     }
@@ -207,9 +208,12 @@ void WaterSim::publish(WindshieldState& out, WorkerThread* helper) const {
       }
     }
   }
+  // (Nearly every particle has the one mass: its radius once.)
+  const double one_mass = particles_.particle_mass(), one_radius = drop_radius_mm(one_mass);
   for (const Particle& p : particles_.particles()) {
-    add(p.pos, drop_radius_mm(p.mass));
-    bodies.push_back(cap(p.pos, drop_radius_mm(p.mass)));
+    const double r = p.mass == one_mass ? one_radius : drop_radius_mm(p.mass);
+    add(p.pos, r);
+    bodies.push_back(cap(p.pos, r));
   }
   surface->index(config_.glass, helper);
   out.glass_wet_fraction = surface->wet_fraction;
