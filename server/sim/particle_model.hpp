@@ -1,6 +1,8 @@
-// The particle model of seed 000 (section 1.2): the water near the wipers as equal
-// particles that never fuse; where two overlap both move apart along the line of their centres by
-// half the overlap, and further by the overlap times a penalty. Glass space, millimetres.
+// The particle model of seed 000 (section 1.2): the water near the wipers as particles made
+// equal, which never fuse as they move (only a blade's strip too deep for its region gathers its
+// water into fewer: blade_sweep.cpp); where two overlap both move apart along the line of their
+// centres by half the overlap, and further by the overlap times a penalty. Glass space,
+// millimetres.
 #pragma once
 
 #include <array>
