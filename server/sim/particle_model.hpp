@@ -47,7 +47,7 @@ class ParticleModel {
 
   std::vector<Particle>& particles() { return particles_; }
   const std::vector<Particle>& particles() const { return particles_; }
-  double particle_mass() const { return particle_mass_; }  // of one particle, mg
+  double particle_mass() const { return particle_mass_; }  // a particle's as made, mg
   double mass() const;
 
  private:

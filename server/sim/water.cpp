@@ -208,7 +208,7 @@ void WaterSim::publish(WindshieldState& out, WorkerThread* helper) const {
       }
     }
   }
-  // (Nearly every particle has the one mass: its radius once.)
+  // (A particle's radius once; that of the mass particles are made with, once for them all.)
   const double one_mass = particles_.particle_mass(), one_radius = drop_radius_mm(one_mass);
   for (const Particle& p : particles_.particles()) {
     const double r = p.mass == one_mass ? one_radius : drop_radius_mm(p.mass);

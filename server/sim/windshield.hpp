@@ -97,7 +97,7 @@ struct WaterConfig {
   // What the renderer sees of trail drops and impact sub-metaballs changes in this many steps over
   // their lives (the sim's masses change smoothly).
   int published_stages = 6;
-  double particle_radius_mm = 1.8;    // particle model: particles made equal (3.5 mg each)
+  double particle_radius_mm = 1.8;    // particle model: 3.5 mg each as made
   double penalty = 0.25;              // repulsion: extra push as a fraction of the overlap
   int region_particle_diameters = 4;  // particle region: blade width + this many diameters a side
   int suspension_cells = 7;           // 7 x 7 search before a particle becomes a mesh drop
