@@ -86,9 +86,8 @@ void BladeSweep::sweep(const WaterInputs& in, MeshModel& mesh, ParticleModel& mo
     // more particles than fit in the particles' region gathers its water into as many as fit: the
     // bead ahead of a blade is one body of water, and in a downpour a strip held 30 particles,
     // pressed 0.37 mm apart, whose repulsion was most of the step's time.
-    const double deepest = std::max(w.region_particle_diameters * 2.0 * rp - rp, rp);
-    const std::size_t fit =
-        static_cast<std::size_t>(std::floor((deepest - rp) / (2.0 * rp) + 1e-9)) + 1;
+    // (The region reaches region_particle_diameters ahead of the edge: that many particles.)
+    const std::size_t fit = static_cast<std::size_t>(std::max(w.region_particle_diameters, 1));
     bool gathered = false;
     for (std::size_t first = 0, end = 0; first < swept_.size(); first = end) {
       end = first;

@@ -1,8 +1,8 @@
 // The wiper blades on the water (seed 000, sections 1.2-1.3): a moving blade pushes the
 // particles it reaches ahead of its leading edge, stacked in the order they stood (a strip too deep
 // for the particles' region gathered into as many as fit), and turns the mesh drops it touches
-// into equal particles. The test is continuous: a point ahead of the blade
-// before the step and within reach of it after was swept, however far the blade turned.
+// into equal particles. The test is continuous: a point ahead of the blade before the step and
+// within reach of it after was swept, however far the blade turned.
 #pragma once
 
 #include <array>
