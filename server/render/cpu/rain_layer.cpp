@@ -82,15 +82,15 @@ struct RainLayer::Batch {
 
 // The haze's transmittance by distance, in a table per build (0-64 m, this view's haze).
 constexpr int kHazeSteps = 256;
+constexpr float kHazeStepM = 64.0f / kHazeSteps;
+constexpr std::uint32_t kHazeStepCm = 25;  // kHazeStepM
+static_assert(kHazeStepCm == static_cast<std::uint32_t>(kHazeStepM * 100.0f));
 // The far streaks' thinning (project_copy). The span of the drops' numbers over which a streak
 // fades in:
 constexpr float kThinFade = 0.125f;
 // The least share drawn: the fewer, each the more opaque, the more the coverage where they overlap,
 // 1 - exp(-sum), falls short of the mean (3% at a half, 11% at a tenth).
 constexpr float kLeastFarShare = 0.25f;
-constexpr float kHazeStepM = 64.0f / kHazeSteps;
-constexpr std::uint32_t kHazeStepCm = 25;  // kHazeStepM
-static_assert(kHazeStepCm == static_cast<std::uint32_t>(kHazeStepM * 100.0f));
 
 struct RainLayer::Frame {
   Frame(const sim::RainState& rain, const RainLayerInputs& in, int width, int height);
